@@ -1,0 +1,43 @@
+# lampnav: the README's two commands, plus a few conveniences.
+#   make demo   install what is missing, build (Release, Ninja, ccache), run the main job
+#   make test   install what is missing, build, run every test
+BUILD_DIR ?= build
+BUILD_TYPE ?= Release
+JOBS ?= $(shell nproc)
+LAMPNAV := $(BUILD_DIR)/apps/lampnav
+OUT ?= lampnav-out
+
+.PHONY: all deps configure build demo test bench format clean
+
+all: build
+
+deps:
+	@bash scripts/install-deps.sh
+
+configure: deps
+	@cmake -S . -B $(BUILD_DIR) -G Ninja -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) >/dev/null
+
+build: configure
+	@cmake --build $(BUILD_DIR) -j $(JOBS)
+
+# The main job. Until the mission runner exists, the job is: validate and draw the default map,
+# then plan a route across it and print the route commands.
+demo: build
+	@mkdir -p $(OUT)
+	$(LAMPNAV) map check maps/office_floor.geojson
+	$(LAMPNAV) map render maps/office_floor.geojson -o $(OUT)/office_floor.png
+	$(LAMPNAV) map render maps/office_floor.geojson -o $(OUT)/office_floor.svg
+	$(LAMPNAV) route maps/office_floor.geojson --from E1 --to D6
+	@echo "drawings written to $(OUT)/" >&2
+
+test: build
+	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+
+bench: build
+	@cmake --build $(BUILD_DIR) --target benchmarks -j $(JOBS)
+
+format:
+	@git ls-files '*.cpp' '*.hpp' | xargs clang-format -i
+
+clean:
+	@rm -rf $(BUILD_DIR)

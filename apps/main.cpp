@@ -1,0 +1,45 @@
+// lampnav: one program, subcommands as in shared/spec/cli.md. Exit status 0 success, 1 the job ran
+// and failed, 2 bad input or usage. Only results go to stdout; diagnostics go to stderr.
+
+#include <CLI/CLI.hpp>
+#include <iostream>
+
+#include "commands.hpp"
+#include "lampnav/core/error.hpp"
+
+namespace lampnav::apps {
+void diagnostic(const std::string& kind, const std::string& text) {
+  std::cerr << "lampnav: " << kind << ": " << text << "\n";
+}
+}  // namespace lampnav::apps
+
+int main(int argc, char** argv) {
+  using namespace lampnav;
+  CLI::App app{"lampnav: indoor navigation by the ceiling lamps", "lampnav"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "lampnav 0.1.0");
+  apps::Job run;
+  apps::add_map_commands(app, run);
+  apps::add_route_command(app, run);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);  // prints help (code 0) or the usage error
+    return code == 0 ? 0 : 2;
+  }
+  try {
+    return run ? run() : 2;
+  } catch (const InputErrors& e) {
+    for (const auto& p : e.problems()) apps::diagnostic("error", p.what());
+    return 2;
+  } catch (const InputError& e) {
+    apps::diagnostic("error", e.what());
+    return 2;
+  } catch (const JobFailed& e) {
+    apps::diagnostic("failed", e.what());
+    return 1;
+  } catch (const std::exception& e) {
+    apps::diagnostic("error", e.what());
+    return 1;
+  }
+}

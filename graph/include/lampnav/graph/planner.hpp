@@ -1,0 +1,25 @@
+#pragma once
+// Route planning: the cheapest path over the one-way edges' costs (Dijkstra).
+
+#include <optional>
+#include <vector>
+
+#include "lampnav/core/pose2.hpp"
+#include "lampnav/graph/map.hpp"
+
+namespace lampnav::graph {
+
+struct Route {
+  std::vector<NodeId> nodes;  // from start to goal, both included
+  std::vector<EdgeId> edges;  // nodes.size() - 1 edges
+  double cost = 0.0;
+};
+
+// The cheapest route, or nullopt when the goal cannot be reached. Throws lampnav::Error when an
+// id names no node.
+std::optional<Route> plan_route(const TopologicalMap& map, NodeId from, NodeId to);
+// From a pose: starts in the node whose region contains it. Throws lampnav::Error when the pose
+// lies in no region.
+std::optional<Route> plan_route(const TopologicalMap& map, const Pose2& from, NodeId to);
+
+}  // namespace lampnav::graph

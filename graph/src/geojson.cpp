@@ -1,0 +1,410 @@
+#include "lampnav/graph/geojson.hpp"
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
+#include <unordered_map>
+
+#include "lampnav/graph/map_checks.hpp"
+#include "lampnav/internal/json_util.hpp"
+
+namespace lampnav::graph {
+
+using json::Cursor;
+using json::Json;
+using Eigen::Vector2d;
+
+namespace {
+
+// A feature read from the file, before the cross-feature checks.
+struct ParsedFeature {
+  std::size_t index = 0;
+  std::string place;  // "features[3] (id 12)"
+  bool is_node = false;
+  Node node;
+  Edge edge;
+};
+
+Vector2d read_xy(const Cursor& c) {
+  c.array_size(2, 2);
+  return {c[0].number(), c[1].number()};
+}
+
+Polygon read_region(const Cursor& c) {
+  c.only_keys({"x_values", "y_values"});
+  const Cursor xs = c.at("x_values");
+  const Cursor ys = c.at("y_values");
+  const std::size_t n = xs.array_size();
+  if (ys.array_size() != n) {
+    ys.fail("has " + std::to_string(ys.value().size()) + " values but x_values has " +
+            std::to_string(n));
+  }
+  std::vector<Vector2d> v;
+  v.reserve(n);
+  for (std::size_t i = 0; i < n; ++i) v.emplace_back(xs[i].number(), ys[i].number());
+  // A closing vertex equal to the first is a common GIS habit; it adds nothing.
+  if (v.size() > 3 && v.front() == v.back()) v.pop_back();
+  if (v.size() < 3) c.fail("degenerate region: fewer than 3 vertices");
+  Polygon poly(std::move(v));
+  if (poly.area() < 1e-9) c.fail("degenerate region: zero area");
+  if (poly.self_intersects()) c.fail("degenerate region: self-intersecting");
+  return poly;
+}
+
+Lamp read_lamp(const Cursor& c, const Node& owner) {
+  c.only_keys({"id", "xyz", "yaw", "shape", "size"});
+  Lamp l;
+  l.id = LampId(c.at("id").string());
+  const Cursor xyz = c.at("xyz");
+  xyz.array_size(3, 3);
+  l.xyz = {xyz[0].number(), xyz[1].number(), xyz[2].number()};
+  if (l.xyz.z() <= 0) xyz.fail("lamp height z must be above the floor (> 0), found " + xyz[2].value().dump());
+  const std::string shape = c.at("shape").string();
+  const Cursor size = c.at("size");
+  if (shape == "rectangle") {
+    l.shape = LampShape::rectangle;
+    size.array_size(2, 2);
+    l.length = size[0].positive();
+    l.width = size[1].positive();
+    if (l.length < l.width) size.fail("a rectangle's size is [length, width] with length >= width");
+    l.yaw = c.at("yaw").number();  // a rectangle's orientation matters: no default
+    l.yaw_given = true;
+  } else if (shape == "disc") {
+    l.shape = LampShape::disc;
+    size.array_size(1, 1);
+    l.length = l.width = size[0].positive();
+    if (auto yaw = c.find("yaw")) {
+      l.yaw = yaw->number();
+      l.yaw_given = true;
+    }
+  } else {
+    c.at("shape").fail("unknown lamp shape '" + shape + "' (expected rectangle or disc)");
+  }
+  if (!owner.region.contains(l.xyz.head<2>(), 1e-6)) {
+    xyz.fail("lamp '" + l.id.value + "' lies outside its node's region");
+  }
+  return l;
+}
+
+Node read_node(const Cursor& feature, const Cursor& props) {
+  props.only_keys({"id", "frame", "metadata"});
+  Node n;
+  n.id = NodeId(props.at("id").integer());
+  if (auto frame = props.find("frame")) {
+    if (frame->string() != "map") frame->fail("frame must be \"map\", found " + frame->value().dump());
+  }
+  const Cursor geom = feature.at("geometry");
+  geom.only_keys({"type", "coordinates"});
+  n.point = read_xy(geom.at("coordinates"));
+
+  const Cursor md = props.at("metadata");
+  md.only_keys({"name", "place", "axis", "width", "region", "doors", "lamps", "length"});
+  n.name = md.at("name").string();
+  const Cursor place = md.at("place");
+  const auto kind = place_from_string(place.string());
+  if (!kind) {
+    place.fail("unknown place '" + place.value().get<std::string>() +
+               "' (expected corridor, junction, corner, end, door, hall or room)");
+  }
+  n.place = *kind;
+  n.region = read_region(md.at("region"));
+  if (auto axis = md.find("axis")) {
+    axis->array_size(2, 2);
+    n.axis = Axis{read_xy((*axis)[0]), read_xy((*axis)[1])};
+    if (n.axis->length() < 1e-6) axis->fail("axis has zero length");
+  } else if (n.place == Place::corridor) {
+    md.at("axis");  // throws "missing": a corridor needs its centreline
+  }
+  if (auto width = md.find("width")) n.width = width->positive();
+  if (auto length = md.find("length")) n.length_override = length->positive();
+  if (auto doors = md.find("doors")) {
+    const std::size_t count = doors->array_size();
+    if (count > 0 && !n.axis) doors->fail("doors are placed along an axis; this node has none");
+    std::set<std::string> names;
+    for (std::size_t i = 0; i < count; ++i) {
+      const Cursor d = (*doors)[i];
+      d.only_keys({"name", "side", "at"});
+      Door door;
+      door.name = d.at("name").string();
+      if (!names.insert(door.name).second) d.at("name").fail("duplicate door name in this node");
+      const std::string side = d.at("side").string();
+      if (side == "left") {
+        door.side = Side::left;
+      } else if (side == "right") {
+        door.side = Side::right;
+      } else {
+        d.at("side").fail("side must be \"left\" or \"right\", found \"" + side + "\"");
+      }
+      door.at = d.at("at").number();
+      if (door.at < 0 || door.at > n.length() + 1e-9) {
+        d.at("at").fail("door lies outside the corridor (0 to " + std::to_string(n.length()) + " m)");
+      }
+      n.doors.push_back(std::move(door));
+    }
+  }
+  if (auto lamps = md.find("lamps")) {
+    const std::size_t count = lamps->array_size();
+    for (std::size_t i = 0; i < count; ++i) n.lamps.push_back(read_lamp((*lamps)[i], n));
+  }
+  return n;
+}
+
+Edge read_edge(const Cursor& feature, const Cursor& props) {
+  props.only_keys({"id", "startid", "endid", "cost", "metadata", "overridable"});
+  Edge e;
+  e.id = EdgeId(props.at("id").integer());
+  e.start = NodeId(props.at("startid").integer());
+  e.end = NodeId(props.at("endid").integer());
+  if (auto cost = props.find("cost")) {
+    const double c = cost->number();
+    if (c < 0) cost->fail("cost must not be negative");
+    e.cost_given = c;
+  }
+  if (auto md = props.find("metadata")) md->only_keys({});
+  if (auto ov = props.find("overridable")) ov->boolean();  // Nav2's flag; accepted, not used
+  const Cursor geom = feature.at("geometry");
+  geom.only_keys({"type", "coordinates"});
+  const Cursor lines = geom.at("coordinates");
+  const std::size_t nl = lines.array_size(1);
+  for (std::size_t i = 0; i < nl; ++i) {
+    const Cursor line = lines[i];
+    const std::size_t np = line.array_size(2);
+    std::vector<Vector2d> pts;
+    for (std::size_t k = 0; k < np; ++k) pts.push_back(read_xy(line[k]));
+    e.geometry.push_back(std::move(pts));
+  }
+  e.cost = e.cost_given ? *e.cost_given : e.geometric_length();
+  return e;
+}
+
+std::string feature_place(std::size_t index, const Json& feature) {
+  std::string place = "features[" + std::to_string(index) + "]";
+  if (feature.is_object()) {
+    auto p = feature.find("properties");
+    if (p != feature.end() && p->is_object()) {
+      auto id = p->find("id");
+      if (id != p->end() && id->is_number()) place += " (id " + id->dump() + ")";
+    }
+  }
+  return place;
+}
+
+}  // namespace
+
+LoadedMap parse_map(const std::string& text, const std::string& source) {
+  const Json doc = json::parse(text, source);
+  const Cursor root(doc, {source, "", ""});
+  root.expect_object();
+  {
+    auto type = doc.find("type");
+    if (type == doc.end() || *type != "FeatureCollection") {
+      root.at("type").fail("not a GeoJSON FeatureCollection");
+    }
+  }
+  root.only_keys({"type", "name", "lampnav", "features", "crs", "bbox"});
+  const Cursor ln = root.at("lampnav");
+  ln.only_keys({"format", "units", "frame"});
+  const Cursor format = ln.at("format");
+  if (!format.value().is_number_integer() || format.value().get<std::int64_t>() != kMapFormat) {
+    format.fail("unknown map format " + format.value().dump() + " (this reader knows format " +
+                std::to_string(kMapFormat) + ")");
+  }
+  if (auto units = ln.find("units")) {
+    if (units->string() != "m") units->fail("units must be \"m\"");
+  }
+  if (auto frame = ln.find("frame")) {
+    if (frame->string() != "map") frame->fail("frame must be \"map\"");
+  }
+  std::string name;
+  if (auto n = root.find("name")) name = n->string();
+
+  const Cursor features = root.at("features");
+  const std::size_t count = features.array_size();
+  std::vector<InputError> problems;
+  std::vector<ParsedFeature> parsed;
+  parsed.reserve(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const Json& fj = features.value()[i];
+    ErrorContext where{source, feature_place(i, fj), ""};
+    const Cursor f(fj, where);
+    try {
+      f.only_keys({"type", "geometry", "properties", "id"});
+      if (f.at("type").string() != "Feature") f.at("type").fail("expected \"Feature\"");
+      const Cursor props = f.at("properties");
+      const std::string gtype = f.at("geometry").at("type").string();
+      ParsedFeature pf;
+      pf.index = i;
+      pf.place = where.place;
+      if (gtype == "Point") {
+        pf.is_node = true;
+        pf.node = read_node(f, props);
+      } else if (gtype == "MultiLineString") {
+        pf.edge = read_edge(f, props);
+      } else {
+        f.at("geometry").at("type").fail("expected Point (a node) or MultiLineString (an edge), found \"" + gtype + "\"");
+      }
+      parsed.push_back(std::move(pf));
+    } catch (const InputError& e) {
+      problems.push_back(e);
+    }
+  }
+
+  // Cross-feature checks: unique ids, names and lamp ids; edges naming nodes; overlapping regions.
+  std::unordered_map<std::int64_t, const ParsedFeature*> by_id;
+  std::unordered_map<std::string, const ParsedFeature*> by_name;
+  std::unordered_map<std::string, const ParsedFeature*> by_lamp;
+  auto problem = [&](const ParsedFeature& f, const std::string& field, const std::string& msg) {
+    problems.emplace_back(ErrorContext{source, f.place, field}, msg);
+  };
+  for (const auto& f : parsed) {
+    const std::int64_t id = f.is_node ? f.node.id.value : f.edge.id.value;
+    auto [it, fresh] = by_id.emplace(id, &f);
+    if (!fresh) problem(f, "properties.id", "duplicate id " + std::to_string(id) + " (also " + it->second->place + ")");
+    if (!f.is_node) continue;
+    auto [nit, nfresh] = by_name.emplace(f.node.name, &f);
+    if (!nfresh) problem(f, "properties.metadata.name", "duplicate name '" + f.node.name + "' (also " + nit->second->place + ")");
+    for (std::size_t k = 0; k < f.node.lamps.size(); ++k) {
+      auto [lit, lfresh] = by_lamp.emplace(f.node.lamps[k].id.value, &f);
+      if (!lfresh) {
+        problem(f, "properties.metadata.lamps[" + std::to_string(k) + "].id",
+                "duplicate lamp id '" + f.node.lamps[k].id.value + "' (also " + lit->second->place + ")");
+      }
+    }
+  }
+  std::set<std::int64_t> node_ids;
+  for (const auto& f : parsed) {
+    if (f.is_node) node_ids.insert(f.node.id.value);
+  }
+  for (const auto& f : parsed) {
+    if (f.is_node) continue;
+    if (!node_ids.count(f.edge.start.value)) {
+      problem(f, "properties.startid", "names no node (" + std::to_string(f.edge.start.value) + ")");
+    }
+    if (!node_ids.count(f.edge.end.value)) {
+      problem(f, "properties.endid", "names no node (" + std::to_string(f.edge.end.value) + ")");
+    }
+    if (f.edge.start == f.edge.end) problem(f, "properties.endid", "edge starts and ends at the same node");
+  }
+  // Overlapping regions: sweep the nodes by their boxes' left edges so only neighbours are paired.
+  std::vector<const ParsedFeature*> nodes;
+  for (const auto& f : parsed) {
+    if (f.is_node) nodes.push_back(&f);
+  }
+  std::sort(nodes.begin(), nodes.end(), [](const auto* a, const auto* b) {
+    return a->node.region.bounds().min.x() < b->node.region.bounds().min.x();
+  });
+  for (std::size_t a = 0; a < nodes.size(); ++a) {
+    const Polygon& ra = nodes[a]->node.region;
+    for (std::size_t b = a + 1; b < nodes.size(); ++b) {
+      const Polygon& rb = nodes[b]->node.region;
+      if (rb.bounds().min.x() > ra.bounds().max.x()) break;
+      if (!ra.bounds().intersects(rb.bounds())) continue;
+      const double overlap = intersection_area(ra, rb);
+      if (overlap > kRegionOverlapTolerance) {
+        const auto* later = nodes[a]->index > nodes[b]->index ? nodes[a] : nodes[b];
+        const auto* earlier = later == nodes[a] ? nodes[b] : nodes[a];
+        char buf[64];
+        std::snprintf(buf, sizeof buf, "%.3f", overlap);
+        problem(*later, "properties.metadata.region",
+                "region overlaps the region of '" + earlier->node.name + "' (" + earlier->place +
+                    ") by " + buf + " m^2");
+      }
+    }
+  }
+  if (!problems.empty()) {
+    std::stable_sort(problems.begin(), problems.end(), [](const InputError& x, const InputError& y) {
+      return x.where().place.size() != y.where().place.size()
+                 ? x.where().place.size() < y.where().place.size()
+                 : x.where().place < y.where().place;
+    });
+    throw InputErrors(std::move(problems));
+  }
+
+  LoadedMap out{TopologicalMap(name), {}};
+  for (auto& f : parsed) {
+    if (f.is_node) out.map.add_node(std::move(f.node));
+  }
+  for (auto& f : parsed) {
+    if (!f.is_node) out.map.add_edge(std::move(f.edge));
+  }
+  out.warnings = check_map(out.map, {}, source);
+  return out;
+}
+
+LoadedMap read_map(const std::string& path) { return parse_map(json::read_file(path), path); }
+
+namespace {
+using OJson = nlohmann::ordered_json;
+OJson xy(const Vector2d& p) { return OJson::array({p.x(), p.y()}); }
+}  // namespace
+
+std::string write_map(const TopologicalMap& map) {
+  OJson doc;
+  doc["type"] = "FeatureCollection";
+  if (!map.name().empty()) doc["name"] = map.name();
+  doc["lampnav"] = {{"format", kMapFormat}, {"units", "m"}, {"frame", "map"}};
+  OJson features = OJson::array();
+  for (const Node& n : map.nodes()) {
+    OJson md;
+    md["name"] = n.name;
+    md["place"] = to_string(n.place);
+    if (n.axis) md["axis"] = OJson::array({xy(n.axis->first), xy(n.axis->second)});
+    if (n.width) md["width"] = *n.width;
+    if (n.length_override) md["length"] = *n.length_override;
+    OJson xs = OJson::array(), ys = OJson::array();
+    for (const auto& v : n.region.vertices()) {
+      xs.push_back(v.x());
+      ys.push_back(v.y());
+    }
+    md["region"] = {{"x_values", xs}, {"y_values", ys}};
+    if (!n.doors.empty()) {
+      OJson doors = OJson::array();
+      for (const auto& d : n.doors) doors.push_back({{"name", d.name}, {"side", to_string(d.side)}, {"at", d.at}});
+      md["doors"] = doors;
+    }
+    OJson lamps = OJson::array();
+    for (const auto& l : n.lamps) {
+      OJson lj;
+      lj["id"] = l.id.value;
+      lj["xyz"] = {l.xyz.x(), l.xyz.y(), l.xyz.z()};
+      if (l.yaw_given) lj["yaw"] = l.yaw;
+      lj["shape"] = to_string(l.shape);
+      lj["size"] = l.shape == LampShape::rectangle ? OJson::array({l.length, l.width}) : OJson::array({l.length});
+      lamps.push_back(lj);
+    }
+    md["lamps"] = lamps;
+    OJson f;
+    f["type"] = "Feature";
+    f["geometry"] = {{"type", "Point"}, {"coordinates", xy(n.point)}};
+    f["properties"] = {{"id", n.id.value}, {"frame", "map"}, {"metadata", md}};
+    features.push_back(f);
+  }
+  for (const Edge& e : map.edges()) {
+    OJson lines = OJson::array();
+    for (const auto& line : e.geometry) {
+      OJson l = OJson::array();
+      for (const auto& p : line) l.push_back(xy(p));
+      lines.push_back(l);
+    }
+    OJson props = {{"id", e.id.value}, {"startid", e.start.value}, {"endid", e.end.value}};
+    if (e.cost_given) props["cost"] = *e.cost_given;
+    props["metadata"] = OJson::object();
+    OJson f;
+    f["type"] = "Feature";
+    f["geometry"] = {{"type", "MultiLineString"}, {"coordinates", lines}};
+    f["properties"] = props;
+    features.push_back(f);
+  }
+  doc["features"] = features;
+  return doc.dump(1) + "\n";
+}
+
+void save_map(const TopologicalMap& map, const std::string& path) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw Error(path + ": cannot open the file for writing");
+  out << write_map(map);
+  if (!out) throw Error(path + ": write error");
+}
+
+}  // namespace lampnav::graph

@@ -1,0 +1,70 @@
+#pragma once
+// The map's storage: a Boost.Graph adjacency_list whose bundled properties are the public Node
+// and Edge structs, plus id, name and spatial indexes. Private to the graph module.
+
+#include <boost/graph/adjacency_list.hpp>
+#include <cmath>
+#include <cstdint>
+#include <unordered_map>
+
+#include "lampnav/graph/map.hpp"
+
+namespace lampnav::graph {
+
+using Graph = boost::adjacency_list<boost::vecS, boost::vecS, boost::bidirectionalS, Node, Edge>;
+using Vertex = Graph::vertex_descriptor;
+using EdgeDesc = Graph::edge_descriptor;
+
+// A uniform grid over the plane holding indexes of things by the cells their boxes cover.
+class GridIndex {
+ public:
+  explicit GridIndex(double cell = 4.0) : cell_(cell) {}
+  void insert(const Box2& box, std::size_t index);
+  // Calls f(index) for every index whose box may meet `box` (an index may come more than once).
+  template <class F>
+  void query(const Box2& box, F&& f) const {
+    const auto [x0, y0] = cell_of(box.min);
+    const auto [x1, y1] = cell_of(box.max);
+    for (std::int64_t x = x0; x <= x1; ++x) {
+      for (std::int64_t y = y0; y <= y1; ++y) {
+        auto it = cells_.find(key(x, y));
+        if (it == cells_.end()) continue;
+        for (std::size_t i : it->second) f(i);
+      }
+    }
+  }
+
+ private:
+  std::pair<std::int64_t, std::int64_t> cell_of(const Eigen::Vector2d& p) const {
+    return {static_cast<std::int64_t>(std::floor(p.x() / cell_)),
+            static_cast<std::int64_t>(std::floor(p.y() / cell_))};
+  }
+  static std::uint64_t key(std::int64_t x, std::int64_t y) {
+    return (static_cast<std::uint64_t>(x) << 32) ^ (static_cast<std::uint64_t>(y) & 0xffffffffULL);
+  }
+  double cell_;
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells_;
+};
+
+struct LampRef {
+  Vertex vertex;
+  std::size_t index;  // in the node's lamp sequence
+};
+
+struct TopologicalMap::Impl {
+  std::string name;
+  Graph g;
+  std::vector<EdgeDesc> edge_order;  // insertion order
+  std::unordered_map<std::int64_t, Vertex> vertex_by_id;
+  std::unordered_map<std::int64_t, std::size_t> edge_by_id;  // index into edge_order
+  std::unordered_map<std::string, Vertex> vertex_by_name;
+  std::unordered_map<std::string, LampRef> lamp_by_id;
+  std::vector<LampRef> lamps;  // all lamps, in insertion order
+  GridIndex region_index;      // vertex indexes by region bounds
+  GridIndex lamp_index{2.0};   // indexes into `lamps` by position
+
+  Vertex vertex(NodeId id) const;
+  const Lamp& lamp(const LampRef& r) const { return g[r.vertex].lamps[r.index]; }
+};
+
+}  // namespace lampnav::graph

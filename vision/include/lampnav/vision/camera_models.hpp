@@ -1,0 +1,69 @@
+#pragma once
+// The camera models of conventions.md. Pixel coordinates: u right, v down, integer values at
+// pixel CENTRES (OpenCV's convention).
+
+#include <Eigen/Core>
+#include <optional>
+
+#include "lampnav/core/robot_description.hpp"
+
+namespace lampnav::vision {
+
+// Pinhole with OpenCV's radial-tangential distortion [k1, k2, p1, p2, k3].
+class PinholeCamera {
+ public:
+  // Throws lampnav::Error when the description is not a pinhole camera.
+  explicit PinholeCamera(const CameraDescription& description);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  const PinholeParameters& parameters() const { return p_; }
+
+  // Pixel of a camera-frame point; nullopt behind the lens or beyond the radius where the
+  // distortion polynomial folds back.
+  std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& point) const;
+  // Unit ray (Z > 0) through a pixel, undoing the distortion iteratively.
+  Eigen::Vector3d unproject(const Eigen::Vector2d& pixel) const;
+  // Normalized image coordinates (x, y) = (X/Z, Y/Z) -> distorted ones, and back.
+  Eigen::Vector2d distort(const Eigen::Vector2d& xy) const;
+  Eigen::Vector2d undistort(const Eigen::Vector2d& xy_distorted) const;
+  // Whether a pixel lies in the image (pixel centres 0..W-1, 0..H-1, with half a pixel of border).
+  bool in_image(const Eigen::Vector2d& pixel) const;
+
+ private:
+  PinholeParameters p_;
+  int width_, height_;
+  double max_r2_;  // normalized radius^2 where the distortion stops growing
+};
+
+// Pajdla-Bakstein fisheye: theta = atan2(sqrt(X^2+Y^2), Z), phi = atan2(Y, X),
+// r = a tan(theta / b) + c sin(theta / d), u = u0 + r cos(phi), v = v0 + beta r sin(phi).
+class FisheyeCamera {
+ public:
+  explicit FisheyeCamera(const CameraDescription& description);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  const FisheyeParameters& parameters() const { return p_; }
+  double max_theta() const { return max_theta_; }  // rad, half the field of view
+
+  // Radius (px) at an off-axis angle theta (rad), and its inverse on [0, max_theta].
+  double radius(double theta) const;
+  std::optional<double> theta_of_radius(double r) const;
+
+  std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& point) const;
+  // Unit ray through a pixel; nullopt outside the field of view.
+  std::optional<Eigen::Vector3d> unproject(const Eigen::Vector2d& pixel) const;
+  bool in_image(const Eigen::Vector2d& pixel) const;
+
+ private:
+  FisheyeParameters p_;
+  int width_, height_;
+  double max_theta_;
+};
+
+// How long a stretch of ceiling the camera sees along the robot's forward axis (base x), on the
+// line through the camera, for a ceiling `height` (m above the floor). 0 when it sees none.
+double ceiling_view_length(const CameraDescription& camera, double height);
+
+}  // namespace lampnav::vision

@@ -1,0 +1,166 @@
+#include "lampnav/vision/camera_models.hpp"
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "lampnav/core/error.hpp"
+
+namespace lampnav::vision {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+namespace {
+// d/dr of r * radial(r^2) = 1 + 3 k1 r^2 + 5 k2 r^4 + 7 k3 r^6: the mapping folds back where this
+// first reaches zero. Scanned in r^2 up to a generous bound (normalized radius 10, 84 degrees).
+double fold_radius2(const std::array<double, 5>& k) {
+  const double k1 = k[0], k2 = k[1], k3 = k[4];
+  auto slope = [&](double s) { return 1 + 3 * k1 * s + 5 * k2 * s * s + 7 * k3 * s * s * s; };
+  const double limit = 100.0;
+  double prev = 0.0;
+  for (double s = 1e-3; s <= limit; s += 1e-3 * (1 + s)) {
+    if (slope(s) <= 0) {
+      double lo = prev, hi = s;  // refine by bisection
+      for (int i = 0; i < 60; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        (slope(mid) > 0 ? lo : hi) = mid;
+      }
+      return lo;
+    }
+    prev = s;
+  }
+  return limit;
+}
+}  // namespace
+
+PinholeCamera::PinholeCamera(const CameraDescription& d)
+    : p_(d.pinhole), width_(d.width), height_(d.height) {
+  if (d.model != CameraModelKind::pinhole) throw Error("camera '" + d.name + "' is not a pinhole camera");
+  max_r2_ = fold_radius2(p_.distortion);
+}
+
+Vector2d PinholeCamera::distort(const Vector2d& xy) const {
+  const auto& k = p_.distortion;
+  const double x = xy.x(), y = xy.y();
+  const double r2 = x * x + y * y;
+  const double radial = 1 + k[0] * r2 + k[1] * r2 * r2 + k[4] * r2 * r2 * r2;
+  return {x * radial + 2 * k[2] * x * y + k[3] * (r2 + 2 * x * x),
+          y * radial + k[2] * (r2 + 2 * y * y) + 2 * k[3] * x * y};
+}
+
+Vector2d PinholeCamera::undistort(const Vector2d& xd) const {
+  // Fixed-point iteration (as OpenCV's undistortPoints), then Gauss-Newton polish.
+  Vector2d xy = xd;
+  for (int i = 0; i < 20; ++i) {
+    const Vector2d e = distort(xy) - xd;
+    if (e.squaredNorm() < 1e-24) break;
+    // Numerical Jacobian of distort at xy.
+    Eigen::Matrix2d J;
+    const double h = 1e-7;
+    J.col(0) = (distort(xy + Vector2d(h, 0)) - distort(xy - Vector2d(h, 0))) / (2 * h);
+    J.col(1) = (distort(xy + Vector2d(0, h)) - distort(xy - Vector2d(0, h))) / (2 * h);
+    xy -= J.lu().solve(e);
+  }
+  return xy;
+}
+
+std::optional<Vector2d> PinholeCamera::project(const Vector3d& p) const {
+  if (!(p.z() > 0)) return std::nullopt;
+  const Vector2d xy(p.x() / p.z(), p.y() / p.z());
+  if (xy.squaredNorm() > max_r2_) return std::nullopt;
+  const Vector2d d = distort(xy);
+  return Vector2d(p_.fx * d.x() + p_.cx, p_.fy * d.y() + p_.cy);
+}
+
+Vector3d PinholeCamera::unproject(const Vector2d& px) const {
+  const Vector2d xd((px.x() - p_.cx) / p_.fx, (px.y() - p_.cy) / p_.fy);
+  const Vector2d xy = undistort(xd);
+  return Vector3d(xy.x(), xy.y(), 1.0).normalized();
+}
+
+bool PinholeCamera::in_image(const Vector2d& px) const {
+  return px.x() >= -0.5 && px.y() >= -0.5 && px.x() <= width_ - 0.5 && px.y() <= height_ - 0.5;
+}
+
+FisheyeCamera::FisheyeCamera(const CameraDescription& d)
+    : p_(d.fisheye), width_(d.width), height_(d.height) {
+  if (d.model != CameraModelKind::pajdla_bakstein) {
+    throw Error("camera '" + d.name + "' is not a pajdla_bakstein camera");
+  }
+  max_theta_ = 0.5 * p_.fov_deg * M_PI / 180.0;
+}
+
+double FisheyeCamera::radius(double theta) const {
+  return p_.a * std::tan(theta / p_.b) + p_.c * std::sin(theta / p_.d);
+}
+
+std::optional<double> FisheyeCamera::theta_of_radius(double r) const {
+  if (r < 0 || r > radius(max_theta_)) return std::nullopt;
+  // r(theta) rises monotonically on [0, max_theta] for physical parameters: bisection is exact
+  // to double precision in 60 steps and cannot diverge.
+  double lo = 0, hi = max_theta_;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (radius(mid) < r ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+std::optional<Vector2d> FisheyeCamera::project(const Vector3d& p) const {
+  const double rho = std::hypot(p.x(), p.y());
+  const double theta = std::atan2(rho, p.z());
+  if (theta > max_theta_ || p.norm() == 0) return std::nullopt;
+  const double phi = std::atan2(p.y(), p.x());
+  const double r = radius(theta);
+  return Vector2d(p_.u0 + r * std::cos(phi), p_.v0 + p_.beta * r * std::sin(phi));
+}
+
+std::optional<Vector3d> FisheyeCamera::unproject(const Vector2d& px) const {
+  const double dx = px.x() - p_.u0;
+  const double dy = (px.y() - p_.v0) / p_.beta;
+  const auto theta = theta_of_radius(std::hypot(dx, dy));
+  if (!theta) return std::nullopt;
+  const double phi = std::atan2(dy, dx);
+  return Vector3d(std::sin(*theta) * std::cos(phi), std::sin(*theta) * std::sin(phi), std::cos(*theta));
+}
+
+bool FisheyeCamera::in_image(const Vector2d& px) const {
+  return px.x() >= -0.5 && px.y() >= -0.5 && px.x() <= width_ - 0.5 && px.y() <= height_ - 0.5;
+}
+
+double ceiling_view_length(const CameraDescription& camera, double height) {
+  const Eigen::Matrix3d R = camera.mount.rotation();
+  const Vector3d origin = camera.mount.xyz;
+  if (!(height > origin.z())) return 0.0;
+  std::optional<PinholeCamera> pinhole;
+  std::optional<FisheyeCamera> fisheye;
+  if (camera.model == CameraModelKind::pinhole) {
+    pinhole.emplace(camera);
+  } else {
+    fisheye.emplace(camera);
+  }
+  auto visible = [&](double s) {
+    const Vector3d p_base(origin.x() + s, origin.y(), height);
+    const Vector3d p_cam = R.transpose() * (p_base - origin);
+    const auto px = pinhole ? pinhole->project(p_cam) : fisheye->project(p_cam);
+    return px && (pinhole ? pinhole->in_image(*px) : fisheye->in_image(*px));
+  };
+  if (!visible(0.0)) return 0.0;
+  // Walk out each way to the edge of the view, then bisect the edge.
+  auto reach = [&](double dir) {
+    double lo = 0, hi = 0.05;
+    const double far = 1e3 * (height - origin.z());
+    while (visible(dir * hi) && hi < far) {
+      lo = hi;
+      hi *= 1.5;
+    }
+    for (int i = 0; i < 50; ++i) {
+      const double mid = 0.5 * (lo + hi);
+      (visible(dir * mid) ? lo : hi) = mid;
+    }
+    return lo;
+  };
+  return reach(+1.0) + reach(-1.0);
+}
+
+}  // namespace lampnav::vision
