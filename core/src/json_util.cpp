@@ -43,6 +43,23 @@ Json parse(const std::string& text, const std::string& file) {
     throw InputError({file, "line " + std::to_string(line) + ", column " + std::to_string(column),
                       ""},
                      "not valid JSON: " + why);
+  } catch (const Json::out_of_range& e) {
+    // A number too large for a double ("1e999"): nlohmann names the token but not its place.
+    const std::string what = e.what();
+    const auto q1 = what.find('\'');
+    const auto q2 = q1 == std::string::npos ? q1 : what.find('\'', q1 + 1);
+    std::string place;
+    std::string token;
+    if (q2 != std::string::npos) {
+      token = what.substr(q1 + 1, q2 - q1 - 1);
+      const auto at = text.find(token);
+      if (at != std::string::npos) {
+        const auto [line, column] = line_column(text, at);
+        place = "line " + std::to_string(line) + ", column " + std::to_string(column);
+      }
+    }
+    throw InputError({file, place, ""},
+                     "not a finite number" + (token.empty() ? std::string() : ": " + token));
   }
 }
 
@@ -88,7 +105,9 @@ void Cursor::only_keys(std::initializer_list<const char*> allowed) const {
     if (!known) {
       std::string list;
       for (const char* a : allowed) list += (list.empty() ? "" : ", ") + std::string(a);
-      child(it.key(), it.value()).fail("unknown key (expected one of: " + list + ")");
+      child(it.key(), it.value())
+          .fail(list.empty() ? "unknown key (this object takes no keys)"
+                             : "unknown key (expected one of: " + list + ")");
     }
   }
 }

@@ -47,8 +47,8 @@ Polygon read_region(const Cursor& c) {
   if (v.size() > 3 && v.front() == v.back()) v.pop_back();
   if (v.size() < 3) c.fail("degenerate region: fewer than 3 vertices");
   Polygon poly(std::move(v));
-  if (poly.area() < 1e-9) c.fail("degenerate region: zero area");
   if (poly.self_intersects()) c.fail("degenerate region: self-intersecting");
+  if (poly.area() < 1e-9) c.fail("degenerate region: zero area");
   return poly;
 }
 
@@ -224,6 +224,7 @@ LoadedMap parse_map(const std::string& text, const std::string& source) {
   std::vector<InputError> problems;
   std::vector<ParsedFeature> parsed;
   parsed.reserve(count);
+  std::set<std::int64_t> failed_ids;
   for (std::size_t i = 0; i < count; ++i) {
     const Json& fj = features.value()[i];
     ErrorContext where{source, feature_place(i, fj), ""};
@@ -247,6 +248,11 @@ LoadedMap parse_map(const std::string& text, const std::string& source) {
       parsed.push_back(std::move(pf));
     } catch (const InputError& e) {
       problems.push_back(e);
+      // Remember the id of a feature that failed, so edges naming it are not also reported.
+      if (fj.is_object() && fj.contains("properties") && fj["properties"].is_object() &&
+          fj["properties"].contains("id") && fj["properties"]["id"].is_number_integer()) {
+        failed_ids.insert(fj["properties"]["id"].get<std::int64_t>());
+      }
     }
   }
 
@@ -272,7 +278,7 @@ LoadedMap parse_map(const std::string& text, const std::string& source) {
       }
     }
   }
-  std::set<std::int64_t> node_ids;
+  std::set<std::int64_t> node_ids = failed_ids;
   for (const auto& f : parsed) {
     if (f.is_node) node_ids.insert(f.node.id.value);
   }

@@ -177,6 +177,7 @@ std::vector<RouteCommand> route_to_commands(const TopologicalMap& map, const Rou
           continuing = next->place == Place::corridor;
         } else {
           c.kind = CommandKind::turn;
+          c.target.clear();  // a turn names the kind of place and its ordinal, not the place
           c.direction = angle > 0 ? TurnDirection::left : TurnDirection::right;
           c.ordinal = passed.places(n.place);
           emit(c);

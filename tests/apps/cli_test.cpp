@@ -1,0 +1,133 @@
+// End-to-end tests of the `lampnav` program: exit statuses, stdout and stderr as cli.md says.
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sys/wait.h>
+
+#include "lampnav_test.hpp"
+
+namespace lampnav {
+namespace {
+
+using ::testing::HasSubstr;
+
+struct Result {
+  int status = -1;
+  std::string out, err;
+};
+
+// Runs lampnav with arguments (shell-quoted by the caller), capturing stdout and stderr.
+Result run(const std::string& args) {
+  const auto dir = std::filesystem::temp_directory_path();
+  const std::string err_file = (dir / ("lampnav_cli_err_" + std::to_string(::getpid()))).string();
+  const std::string cmd = std::string(LAMPNAV_BINARY) + " " + args + " 2>" + err_file;
+  Result r;
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (!p) return r;
+  std::array<char, 4096> buf;
+  std::size_t n;
+  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
+  const int st = ::pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  std::ifstream in(err_file);
+  r.err.assign(std::istreambuf_iterator<char>(in), {});
+  std::filesystem::remove(err_file);
+  return r;
+}
+
+std::string src(const std::string& rel) { return "'" + test::source_path(rel) + "'"; }
+
+TEST(Cli, MapCheckBundledMapsExitZeroWithSummary) {
+  for (const char* m : {"maps/office_floor.geojson", "maps/domus_museum.geojson"}) {
+    const Result r = run("map check " + src(m));
+    EXPECT_EQ(r.status, 0) << r.err;
+    EXPECT_THAT(r.out, HasSubstr("valid"));
+    EXPECT_THAT(r.out, HasSubstr("nodes: "));
+    EXPECT_THAT(r.out, HasSubstr("lamps: "));
+    EXPECT_EQ(r.err, "");
+  }
+}
+
+TEST(Cli, MapCheckWithRobotChecksCoverage) {
+  const Result ok = run("map check " + src("maps/office_floor.geojson") + " --robot " +
+                        src("maps/robots/pioneer.json") + " --speed 0.5 --fps 1");
+  EXPECT_EQ(ok.status, 0);
+  EXPECT_THAT(ok.out, HasSubstr("every lamp seen"));
+  const Result fast = run("map check " + src("maps/office_floor.geojson") + " --robot " +
+                          src("maps/robots/pioneer.json") + " --speed 3 --fps 1");
+  EXPECT_EQ(fast.status, 0);
+  EXPECT_THAT(fast.err, HasSubstr("highest safe speed"));
+}
+
+TEST(Cli, DanglingEdgeExitsTwoNamingTheEdge) {
+  const Result r = run("map check " + src("tests/fixtures/maps/dangling_edge.geojson"));
+  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.out, "");
+  EXPECT_THAT(r.err, HasSubstr("features[3] (id 11): properties.endid: names no node (99)"));
+}
+
+TEST(Cli, RoutePrintsCommands) {
+  const Result r = run("route " + src("maps/office_floor.geojson") + " --from E1 --to D6");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out,
+            "follow corridor C1\n"
+            "turn right at the first corner\n"
+            "follow corridor C3\n"
+            "stop at door D6 (first door on the left)\n");
+  const Result j = run("route " + src("maps/office_floor.geojson") + " --from 'Lab 1' --to Workshop --json");
+  EXPECT_EQ(j.status, 0);
+  EXPECT_THAT(j.out, HasSubstr("\"go through door D7\""));
+  EXPECT_THAT(j.out, HasSubstr("\"nodes\""));
+}
+
+TEST(Cli, RouteErrors) {
+  const Result unknown = run("route " + src("maps/office_floor.geojson") + " --from E1 --to Nowhere");
+  EXPECT_EQ(unknown.status, 2);
+  EXPECT_THAT(unknown.err, HasSubstr("--to: no node named 'Nowhere'"));
+  const Result none = run("route " + src("tests/fixtures/maps/warnings_unreached_and_dark.geojson") +
+                          " --from C1 --to Lonely");
+  EXPECT_EQ(none.status, 1);
+  EXPECT_THAT(none.err, HasSubstr("no route from 'C1' to 'Lonely'"));
+}
+
+TEST(Cli, UsageErrorsExitTwo) {
+  EXPECT_EQ(run("").status, 2);
+  EXPECT_EQ(run("frobnicate").status, 2);
+  EXPECT_EQ(run("route " + src("maps/office_floor.geojson") + " --from E1").status, 2);
+  EXPECT_EQ(run("map check " + src("maps/office_floor.geojson") + " --speed -1").status, 2);
+  EXPECT_EQ(run("map check /nonexistent.geojson").status, 2);
+  const Result help = run("route --help");
+  EXPECT_EQ(help.status, 0);
+  EXPECT_THAT(help.out, HasSubstr("--from"));
+}
+
+TEST(Cli, RenderWritesPngAndSvg) {
+  const auto dir = std::filesystem::temp_directory_path() / ("lampnav_render_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  for (const char* ext : {".png", ".svg"}) {
+    const auto out = dir / (std::string("office") + ext);
+    const Result r = run("map render " + src("maps/office_floor.geojson") + " -o '" + out.string() + "'");
+    EXPECT_EQ(r.status, 0) << r.err;
+    ASSERT_TRUE(std::filesystem::exists(out));
+    EXPECT_GT(std::filesystem::file_size(out), 10000u);
+    std::ifstream in(out, std::ios::binary);
+    std::string head(8, '\0');
+    in.read(head.data(), 8);
+    if (std::string(ext) == ".png") {
+      EXPECT_EQ(head.substr(1, 3), "PNG");
+    } else {
+      EXPECT_THAT(head, HasSubstr("<?xml"));
+    }
+  }
+  const Result bad = run("map render " + src("maps/office_floor.geojson") + " -o '" + (dir / "x.bmp").string() + "'");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_THAT(bad.err, HasSubstr("unknown picture format"));
+  const Result unwritable = run("map render " + src("maps/office_floor.geojson") + " -o /nonexistent/dir/x.png");
+  EXPECT_EQ(unwritable.status, 2);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace lampnav
