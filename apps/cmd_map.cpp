@@ -43,7 +43,8 @@ int run_check(const CheckArgs& a) {
     warnings = all;
     char buf[160];
     std::snprintf(buf, sizeof buf, "camera coverage (%s at %.2f m/s, %.2f frames/s): %s",
-                  a.camera.c_str(), a.speed, a.fps, extra == 0 ? "every lamp seen" : "see warnings");
+                  a.camera.c_str(), a.speed, a.fps,
+                  extra == 0 ? "every lamp seen" : "see warnings");
     coverage_line = buf;
   }
   for (const auto& w : warnings) diagnostic("warning", w.text());
@@ -55,7 +56,8 @@ int run_check(const CheckArgs& a) {
     ++by_place[n.place];
     doors += n.doors.size();
   }
-  std::cout << "map " << (m.name().empty() ? "(unnamed)" : m.name()) << " (" << a.map << "): valid\n";
+  std::cout << "map " << (m.name().empty() ? "(unnamed)" : m.name()) << " (" << a.map
+            << "): valid\n";
   std::cout << "nodes: " << m.node_count() << " (";
   bool first = true;
   for (const auto& [place, count] : by_place) {
@@ -96,7 +98,8 @@ void add_map_commands(CLI::App& app, Job& run) {
   auto drawing = std::make_shared<DrawingOptions>();
   CLI::App* render = map->add_subcommand("render", "Draw regions, graph, lamps, doors and names");
   render->add_option("MAP", render_args->first, "Map file (.geojson)")->required();
-  render->add_option("-o,--output", render_args->second, "Picture to write (.png or .svg)")->required();
+  render->add_option("-o,--output", render_args->second, "Picture to write (.png or .svg)")
+      ->required();
   render->add_option("--size", drawing->max_size_px, "Longer side of the picture (px)")
       ->capture_default_str()
       ->check(CLI::Range(200, 20000));

@@ -54,7 +54,8 @@ int run_route(const RouteArgs& a) {
 
 void add_route_command(CLI::App& app, Job& run) {
   auto args = std::make_shared<RouteArgs>();
-  CLI::App* cmd = app.add_subcommand("route", "Plan the shortest route and print its route commands");
+  CLI::App* cmd =
+      app.add_subcommand("route", "Plan the shortest route and print its route commands");
   cmd->add_option("MAP", args->map, "Map file (.geojson)")->required();
   cmd->add_option("--from", args->from, "Start node name")->required();
   cmd->add_option("--to", args->to, "Goal node name")->required();

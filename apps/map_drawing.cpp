@@ -11,8 +11,8 @@
 
 namespace lampnav::apps {
 
-using graph::Place;
 using Eigen::Vector2d;
+using graph::Place;
 
 namespace {
 
@@ -22,13 +22,20 @@ struct Rgb {
 
 Rgb place_colour(Place p) {
   switch (p) {
-    case Place::corridor: return {0.80, 0.87, 0.95};
-    case Place::junction: return {0.62, 0.76, 0.92};
-    case Place::corner: return {0.70, 0.82, 0.70};
-    case Place::end: return {0.88, 0.80, 0.92};
-    case Place::door: return {0.85, 0.62, 0.40};
-    case Place::hall: return {0.93, 0.90, 0.78};
-    case Place::room: return {0.92, 0.92, 0.92};
+    case Place::corridor:
+      return {0.80, 0.87, 0.95};
+    case Place::junction:
+      return {0.62, 0.76, 0.92};
+    case Place::corner:
+      return {0.70, 0.82, 0.70};
+    case Place::end:
+      return {0.88, 0.80, 0.92};
+    case Place::door:
+      return {0.85, 0.62, 0.40};
+    case Place::hall:
+      return {0.93, 0.90, 0.78};
+    case Place::room:
+      return {0.92, 0.92, 0.92};
   }
   return {1, 1, 1};
 }
@@ -93,7 +100,8 @@ void draw(cairo_t* cr, const graph::TopologicalMap& map, const View& v, const Dr
     const Vector2d left(-dir.y(), dir.x());
     const double half_width = n.width.value_or(2.0) / 2;
     for (const auto& d : n.doors) {
-      const Vector2d c = n.axis->point_at(d.at) + (d.side == graph::Side::left ? 1 : -1) * half_width * left;
+      const Vector2d c =
+          n.axis->point_at(d.at) + (d.side == graph::Side::left ? 1 : -1) * half_width * left;
       const Vector2d a = c - 0.45 * dir, b = c + 0.45 * dir;
       cairo_set_source_rgb(cr, 0.55, 0.30, 0.10);
       cairo_set_line_width(cr, std::max(3.0, 0.15 * v.scale));
@@ -209,9 +217,12 @@ void draw_map(const graph::TopologicalMap& map, const std::string& path,
   const double w = std::ceil(size.x() * v.scale + 2 * v.margin);
   const double h = std::ceil(size.y() * v.scale + 2 * v.margin + 30);  // room for the legend
 
-  cairo_surface_t* surface = png ? cairo_image_surface_create(CAIRO_FORMAT_ARGB32, static_cast<int>(w), static_cast<int>(h))
-                                 : cairo_svg_surface_create(path.c_str(), w, h);
-  std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> guard(surface, cairo_surface_destroy);
+  cairo_surface_t* surface =
+      png ? cairo_image_surface_create(CAIRO_FORMAT_ARGB32, static_cast<int>(w),
+                                       static_cast<int>(h))
+          : cairo_svg_surface_create(path.c_str(), w, h);
+  std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)> guard(surface,
+                                                                           cairo_surface_destroy);
   if (cairo_surface_status(surface) != CAIRO_STATUS_SUCCESS) {
     throw InputError({path, "", ""}, std::string("cannot create the picture: ") +
                                          cairo_status_to_string(cairo_surface_status(surface)));

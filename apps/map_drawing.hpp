@@ -8,8 +8,8 @@
 namespace lampnav::apps {
 
 struct DrawingOptions {
-  int max_size_px = 1600;   // the longer side of the picture, px
-  bool lamp_ids = false;    // label every lamp with its id
+  int max_size_px = 1600;  // the longer side of the picture, px
+  bool lamp_ids = false;   // label every lamp with its id
 };
 
 // Writes `path`; the format follows the extension (.png or .svg). Throws lampnav::InputError

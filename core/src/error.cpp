@@ -13,7 +13,9 @@ std::string format_problem(const ErrorContext& where, const std::string& message
 }
 
 InputError::InputError(ErrorContext where, std::string message)
-    : Error(format_problem(where, message)), where_(std::move(where)), message_(std::move(message)) {}
+    : Error(format_problem(where, message)),
+      where_(std::move(where)),
+      message_(std::move(message)) {}
 
 namespace {
 std::string summarize(const std::vector<InputError>& problems) {

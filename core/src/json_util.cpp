@@ -40,9 +40,9 @@ Json parse(const std::string& text, const std::string& file) {
     // prefix, which repeats the position we already give.
     const auto colon = why.find(": syntax error");
     if (colon != std::string::npos) why = why.substr(colon + 2);
-    throw InputError({file, "line " + std::to_string(line) + ", column " + std::to_string(column),
-                      ""},
-                     "not valid JSON: " + why);
+    throw InputError(
+        {file, "line " + std::to_string(line) + ", column " + std::to_string(column), ""},
+        "not valid JSON: " + why);
   } catch (const Json::out_of_range& e) {
     // A number too large for a double ("1e999"): nlohmann names the token but not its place.
     const std::string what = e.what();
@@ -116,7 +116,8 @@ std::size_t Cursor::array_size(std::size_t min, std::size_t max) const {
   if (!value_->is_array()) fail(std::string("expected an array, found ") + value_->type_name());
   const std::size_t n = value_->size();
   if (n < min || n > max) {
-    if (min == max) fail("expected " + std::to_string(min) + " elements, found " + std::to_string(n));
+    if (min == max)
+      fail("expected " + std::to_string(min) + " elements, found " + std::to_string(n));
     if (max == SIZE_MAX) {
       fail("expected at least " + std::to_string(min) + " elements, found " + std::to_string(n));
     }
@@ -158,7 +159,8 @@ std::string Cursor::string() const {
 }
 
 bool Cursor::boolean() const {
-  if (!value_->is_boolean()) fail(std::string("expected true or false, found ") + value_->type_name());
+  if (!value_->is_boolean())
+    fail(std::string("expected true or false, found ") + value_->type_name());
   return value_->get<bool>();
 }
 

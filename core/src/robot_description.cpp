@@ -55,7 +55,8 @@ CameraDescription read_camera(const Cursor& c) {
   cam.height = read_size(c.at("height"));
   cam.mount = read_mount(c.at("mount"));
   if (model == "pinhole") {
-    c.only_keys({"name", "model", "width", "height", "fx", "fy", "cx", "cy", "distortion", "mount"});
+    c.only_keys(
+        {"name", "model", "width", "height", "fx", "fy", "cx", "cy", "distortion", "mount"});
     cam.model = CameraModelKind::pinhole;
     auto& p = cam.pinhole;
     p.fx = c.at("fx").positive();
@@ -85,7 +86,8 @@ CameraDescription read_camera(const Cursor& c) {
       if (f.fov_deg >= 360.0) fov->fail("must be below 360 degrees");
     }
   } else {
-    c.at("model").fail("unknown camera model '" + model + "' (expected pinhole or pajdla_bakstein)");
+    c.at("model").fail("unknown camera model '" + model +
+                       "' (expected pinhole or pajdla_bakstein)");
   }
   return cam;
 }

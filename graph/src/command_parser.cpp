@@ -11,7 +11,8 @@ namespace lampnav::graph {
 
 CommandParseError::CommandParseError(std::string source, std::string text, std::size_t column,
                                      std::string word, std::string message)
-    : InputError({std::move(source), "column " + std::to_string(column), word.empty() ? "" : "'" + word + "'"},
+    : InputError({std::move(source), "column " + std::to_string(column),
+                  word.empty() ? "" : "'" + word + "'"},
                  std::move(message)),
       text_(std::move(text)),
       column_(column),
@@ -59,7 +60,9 @@ class Parser {
     while (pos_ < toks_.size()) {
       out.push_back(command());
       if (pos_ < toks_.size()) {
-        if (!is_separator(toks_[pos_])) fail(toks_[pos_], "expected the end of the command, or ',' / 'and' / 'then' before the next one");
+        if (!is_separator(toks_[pos_]))
+          fail(toks_[pos_],
+               "expected the end of the command, or ',' / 'and' / 'then' before the next one");
         skip_separators();
       }
     }
@@ -73,7 +76,8 @@ class Parser {
     throw CommandParseError(source_, text_, t.column, word, message);
   }
   [[noreturn]] void fail_at_end(const std::string& message) const {
-    throw CommandParseError(source_, text_, text_.size() + 1, "", message + " (the text ends here)");
+    throw CommandParseError(source_, text_, text_.size() + 1, "",
+                            message + " (the text ends here)");
   }
   [[noreturn]] void fail_here(const std::string& message) const {
     if (pos_ < toks_.size() && !is_separator(toks_[pos_])) fail(toks_[pos_], message);
@@ -116,7 +120,8 @@ class Parser {
     std::string list;
     i = 0;
     for (const char* w : words) {
-      list += (i == 0 ? "" : (i + 1 == words.size() ? " or " : ", ")) + std::string("\"") + w + "\"";
+      list +=
+          (i == 0 ? "" : (i + 1 == words.size() ? " or " : ", ")) + std::string("\"") + w + "\"";
       ++i;
     }
     fail_here("expected " + list);
@@ -137,7 +142,8 @@ class Parser {
       }
       // 1st, 2nd, 3rd, 4th, ... 21st
       std::size_t digits = 0;
-      while (digits < t->lower.size() && std::isdigit(static_cast<unsigned char>(t->lower[digits]))) {
+      while (digits < t->lower.size() &&
+             std::isdigit(static_cast<unsigned char>(t->lower[digits]))) {
         ++digits;
       }
       if (digits > 0 && digits <= 4 && t->lower.size() == digits + 2) {
@@ -154,7 +160,8 @@ class Parser {
   // A name: one quoted string, or the words up to the end of the command or a '('.
   std::string name(const char* what) {
     const Token* t = peek();
-    if (!t || t->kind == Tok::open || t->kind == Tok::close) fail_here(std::string("expected ") + what);
+    if (!t || t->kind == Tok::open || t->kind == Tok::close)
+      fail_here(std::string("expected ") + what);
     if (t->kind == Tok::quoted) {
       ++pos_;
       return t->text;
@@ -190,7 +197,8 @@ class Parser {
         break;
       case 1:  // turn
         c.kind = CommandKind::turn;
-        c.direction = expect_one({"left", "right"}) == 0 ? TurnDirection::left : TurnDirection::right;
+        c.direction =
+            expect_one({"left", "right"}) == 0 ? TurnDirection::left : TurnDirection::right;
         expect("at");
         expect("the");
         c.ordinal = ordinal();
@@ -218,7 +226,8 @@ class Parser {
           which_door(c);
           break;
         }
-        const std::size_t p = expect_one({"door", "corridor", "junction", "corner", "end", "hall", "room"});
+        const std::size_t p =
+            expect_one({"door", "corridor", "junction", "corner", "end", "hall", "room"});
         if (p == 0) {
           c.kind = CommandKind::stop_at_door;
           c.target = name("a door name");
@@ -231,7 +240,7 @@ class Parser {
           }
         } else {
           static const Place places[] = {Place::corridor, Place::junction, Place::corner,
-                                         Place::end, Place::hall, Place::room};
+                                         Place::end,      Place::hall,     Place::room};
           c.kind = CommandKind::stop_at_node;
           c.place = places[p - 1];
           c.target = name("a place name");
@@ -286,8 +295,8 @@ class Parser {
     }
   }
 
-  static constexpr const char* kWords[] = {"first", "second", "third", "fourth", "fifth",
-                                           "sixth", "seventh", "eighth", "ninth", "tenth"};
+  static constexpr const char* kWords[] = {"first", "second",  "third",  "fourth", "fifth",
+                                           "sixth", "seventh", "eighth", "ninth",  "tenth"};
   const std::string& text_;
   std::string source_;
   std::vector<Token> toks_;
@@ -304,7 +313,8 @@ void check_commands(const TopologicalMap& map, const std::vector<RouteCommand>& 
                     const std::string& source) {
   for (std::size_t i = 0; i < commands.size(); ++i) {
     const RouteCommand& c = commands[i];
-    const ErrorContext where{source, "command " + std::to_string(i + 1) + " (" + c.text() + ")", ""};
+    const ErrorContext where{source, "command " + std::to_string(i + 1) + " (" + c.text() + ")",
+                             ""};
     if (c.target.empty()) continue;
     if (c.kind == CommandKind::stop_at_door) {
       // A door may be a door node, or a door listed along a corridor.
@@ -318,15 +328,22 @@ void check_commands(const TopologicalMap& map, const std::vector<RouteCommand>& 
     if (!n) throw InputError(where, "no place named '" + c.target + "' in the map");
     Place want = n->place;
     switch (c.kind) {
-      case CommandKind::follow_corridor: want = Place::corridor; break;
-      case CommandKind::go_through_door: want = Place::door; break;
+      case CommandKind::follow_corridor:
+        want = Place::corridor;
+        break;
+      case CommandKind::go_through_door:
+        want = Place::door;
+        break;
       case CommandKind::enter:
-      case CommandKind::stop_at_node: want = c.place; break;
-      default: break;
+      case CommandKind::stop_at_node:
+        want = c.place;
+        break;
+      default:
+        break;
     }
     if (n->place != want) {
-      throw InputError(where, "'" + c.target + "' is a " + to_string(n->place) + ", not a " +
-                                  to_string(want));
+      throw InputError(
+          where, "'" + c.target + "' is a " + to_string(n->place) + ", not a " + to_string(want));
     }
   }
 }

@@ -11,9 +11,9 @@
 
 namespace lampnav::graph {
 
+using Eigen::Vector2d;
 using json::Cursor;
 using json::Json;
-using Eigen::Vector2d;
 
 namespace {
 
@@ -59,7 +59,8 @@ Lamp read_lamp(const Cursor& c, const Node& owner) {
   const Cursor xyz = c.at("xyz");
   xyz.array_size(3, 3);
   l.xyz = {xyz[0].number(), xyz[1].number(), xyz[2].number()};
-  if (l.xyz.z() <= 0) xyz.fail("lamp height z must be above the floor (> 0), found " + xyz[2].value().dump());
+  if (l.xyz.z() <= 0)
+    xyz.fail("lamp height z must be above the floor (> 0), found " + xyz[2].value().dump());
   const std::string shape = c.at("shape").string();
   const Cursor size = c.at("size");
   if (shape == "rectangle") {
@@ -92,7 +93,8 @@ Node read_node(const Cursor& feature, const Cursor& props) {
   Node n;
   n.id = NodeId(props.at("id").integer());
   if (auto frame = props.find("frame")) {
-    if (frame->string() != "map") frame->fail("frame must be \"map\", found " + frame->value().dump());
+    if (frame->string() != "map")
+      frame->fail("frame must be \"map\", found " + frame->value().dump());
   }
   const Cursor geom = feature.at("geometry");
   geom.only_keys({"type", "coordinates"});
@@ -138,7 +140,8 @@ Node read_node(const Cursor& feature, const Cursor& props) {
       }
       door.at = d.at("at").number();
       if (door.at < 0 || door.at > n.length() + 1e-9) {
-        d.at("at").fail("door lies outside the corridor (0 to " + std::to_string(n.length()) + " m)");
+        d.at("at").fail("door lies outside the corridor (0 to " + std::to_string(n.length()) +
+                        " m)");
       }
       n.doors.push_back(std::move(door));
     }
@@ -243,7 +246,9 @@ LoadedMap parse_map(const std::string& text, const std::string& source) {
       } else if (gtype == "MultiLineString") {
         pf.edge = read_edge(f, props);
       } else {
-        f.at("geometry").at("type").fail("expected Point (a node) or MultiLineString (an edge), found \"" + gtype + "\"");
+        f.at("geometry")
+            .at("type")
+            .fail("expected Point (a node) or MultiLineString (an edge), found \"" + gtype + "\"");
       }
       parsed.push_back(std::move(pf));
     } catch (const InputError& e) {
@@ -266,15 +271,20 @@ LoadedMap parse_map(const std::string& text, const std::string& source) {
   for (const auto& f : parsed) {
     const std::int64_t id = f.is_node ? f.node.id.value : f.edge.id.value;
     auto [it, fresh] = by_id.emplace(id, &f);
-    if (!fresh) problem(f, "properties.id", "duplicate id " + std::to_string(id) + " (also " + it->second->place + ")");
+    if (!fresh)
+      problem(f, "properties.id",
+              "duplicate id " + std::to_string(id) + " (also " + it->second->place + ")");
     if (!f.is_node) continue;
     auto [nit, nfresh] = by_name.emplace(f.node.name, &f);
-    if (!nfresh) problem(f, "properties.metadata.name", "duplicate name '" + f.node.name + "' (also " + nit->second->place + ")");
+    if (!nfresh)
+      problem(f, "properties.metadata.name",
+              "duplicate name '" + f.node.name + "' (also " + nit->second->place + ")");
     for (std::size_t k = 0; k < f.node.lamps.size(); ++k) {
       auto [lit, lfresh] = by_lamp.emplace(f.node.lamps[k].id.value, &f);
       if (!lfresh) {
         problem(f, "properties.metadata.lamps[" + std::to_string(k) + "].id",
-                "duplicate lamp id '" + f.node.lamps[k].id.value + "' (also " + lit->second->place + ")");
+                "duplicate lamp id '" + f.node.lamps[k].id.value + "' (also " + lit->second->place +
+                    ")");
       }
     }
   }
@@ -285,12 +295,14 @@ LoadedMap parse_map(const std::string& text, const std::string& source) {
   for (const auto& f : parsed) {
     if (f.is_node) continue;
     if (!node_ids.count(f.edge.start.value)) {
-      problem(f, "properties.startid", "names no node (" + std::to_string(f.edge.start.value) + ")");
+      problem(f, "properties.startid",
+              "names no node (" + std::to_string(f.edge.start.value) + ")");
     }
     if (!node_ids.count(f.edge.end.value)) {
       problem(f, "properties.endid", "names no node (" + std::to_string(f.edge.end.value) + ")");
     }
-    if (f.edge.start == f.edge.end) problem(f, "properties.endid", "edge starts and ends at the same node");
+    if (f.edge.start == f.edge.end)
+      problem(f, "properties.endid", "edge starts and ends at the same node");
   }
   // Overlapping regions: sweep the nodes by their boxes' left edges so only neighbours are paired.
   std::vector<const ParsedFeature*> nodes;
@@ -319,11 +331,12 @@ LoadedMap parse_map(const std::string& text, const std::string& source) {
     }
   }
   if (!problems.empty()) {
-    std::stable_sort(problems.begin(), problems.end(), [](const InputError& x, const InputError& y) {
-      return x.where().place.size() != y.where().place.size()
-                 ? x.where().place.size() < y.where().place.size()
-                 : x.where().place < y.where().place;
-    });
+    std::stable_sort(problems.begin(), problems.end(),
+                     [](const InputError& x, const InputError& y) {
+                       return x.where().place.size() != y.where().place.size()
+                                  ? x.where().place.size() < y.where().place.size()
+                                  : x.where().place < y.where().place;
+                     });
     throw InputErrors(std::move(problems));
   }
 
@@ -366,7 +379,8 @@ std::string write_map(const TopologicalMap& map) {
     md["region"] = {{"x_values", xs}, {"y_values", ys}};
     if (!n.doors.empty()) {
       OJson doors = OJson::array();
-      for (const auto& d : n.doors) doors.push_back({{"name", d.name}, {"side", to_string(d.side)}, {"at", d.at}});
+      for (const auto& d : n.doors)
+        doors.push_back({{"name", d.name}, {"side", to_string(d.side)}, {"at", d.at}});
       md["doors"] = doors;
     }
     OJson lamps = OJson::array();
@@ -376,7 +390,8 @@ std::string write_map(const TopologicalMap& map) {
       lj["xyz"] = {l.xyz.x(), l.xyz.y(), l.xyz.z()};
       if (l.yaw_given) lj["yaw"] = l.yaw;
       lj["shape"] = to_string(l.shape);
-      lj["size"] = l.shape == LampShape::rectangle ? OJson::array({l.length, l.width}) : OJson::array({l.length});
+      lj["size"] = l.shape == LampShape::rectangle ? OJson::array({l.length, l.width})
+                                                   : OJson::array({l.length});
       lamps.push_back(lj);
     }
     md["lamps"] = lamps;

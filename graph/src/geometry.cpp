@@ -25,7 +25,8 @@ double point_segment_distance(const Vector2d& p, const Vector2d& a, const Vector
 
 // Clips convex polygon `subject` by the convex counter-clockwise polygon `clip`
 // (Sutherland-Hodgman), returning the area of what is left.
-double convex_intersection_area(std::vector<Vector2d> subject, const std::array<Vector2d, 3>& clip) {
+double convex_intersection_area(std::vector<Vector2d> subject,
+                                const std::array<Vector2d, 3>& clip) {
   for (std::size_t i = 0; i < 3 && !subject.empty(); ++i) {
     const Vector2d& a = clip[i];
     const Vector2d& b = clip[(i + 1) % 3];
@@ -42,7 +43,8 @@ double convex_intersection_area(std::vector<Vector2d> subject, const std::array<
   }
   if (subject.size() < 3) return 0.0;
   double a2 = 0;
-  for (std::size_t j = 0; j < subject.size(); ++j) a2 += cross(subject[j], subject[(j + 1) % subject.size()]);
+  for (std::size_t j = 0; j < subject.size(); ++j)
+    a2 += cross(subject[j], subject[(j + 1) % subject.size()]);
   return std::fabs(a2) * 0.5;
 }
 }  // namespace
@@ -181,7 +183,8 @@ std::vector<std::array<Vector2d, 3>> Polygon::triangulate() const {
     }
     ++guard;
   }
-  if (ring.size() == 3 && orient(ring[0], ring[1], ring[2]) > 0) tris.push_back({ring[0], ring[1], ring[2]});
+  if (ring.size() == 3 && orient(ring[0], ring[1], ring[2]) > 0)
+    tris.push_back({ring[0], ring[1], ring[2]});
   return tris;
 }
 

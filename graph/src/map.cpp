@@ -8,13 +8,20 @@ namespace lampnav::graph {
 
 const char* to_string(Place p) {
   switch (p) {
-    case Place::corridor: return "corridor";
-    case Place::junction: return "junction";
-    case Place::corner: return "corner";
-    case Place::end: return "end";
-    case Place::door: return "door";
-    case Place::hall: return "hall";
-    case Place::room: return "room";
+    case Place::corridor:
+      return "corridor";
+    case Place::junction:
+      return "junction";
+    case Place::corner:
+      return "corner";
+    case Place::end:
+      return "end";
+    case Place::door:
+      return "door";
+    case Place::hall:
+      return "hall";
+    case Place::room:
+      return "room";
   }
   return "?";
 }

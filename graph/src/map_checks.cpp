@@ -76,21 +76,20 @@ std::vector<MapWarning> check_map(const TopologicalMap& map, const MapCheckOptio
         double spacing = INFINITY;
         if (i + 1 < node.lamps.size()) spacing = (node.lamps[i + 1].xyz - l.xyz).head<2>().norm();
         if (i > 0) spacing = std::min(spacing, (node.lamps[i - 1].xyz - l.xyz).head<2>().norm());
-        const double vmax = max_speed_every_lamp_seen(cov.view_length(l.xyz.z()),
-                                                      l.extent_along(heading), spacing,
-                                                      cov.frame_rate);
+        const double vmax = max_speed_every_lamp_seen(
+            cov.view_length(l.xyz.z()), l.extent_along(heading), spacing, cov.frame_rate);
         if (vmax < worst) {
           worst = vmax;
           worst_i = i;
         }
       }
       if (worst < cov.speed) {
-        out.push_back({{file, node_place(node),
-                        "properties.metadata.lamps[" + std::to_string(worst_i) + "]"},
-                       "at " + fmt(cov.speed) + " m/s and " + fmt(cov.frame_rate) +
-                           " frames/s the ceiling camera could miss or confuse lamp '" +
-                           node.lamps[worst_i].id.value + "'; the highest safe speed here is " +
-                           fmt(worst) + " m/s"});
+        out.push_back(
+            {{file, node_place(node), "properties.metadata.lamps[" + std::to_string(worst_i) + "]"},
+             "at " + fmt(cov.speed) + " m/s and " + fmt(cov.frame_rate) +
+                 " frames/s the ceiling camera could miss or confuse lamp '" +
+                 node.lamps[worst_i].id.value + "'; the highest safe speed here is " + fmt(worst) +
+                 " m/s"});
       }
     }
   }

@@ -25,8 +25,10 @@ std::optional<Route> plan_route(const TopologicalMap& map, NodeId from, NodeId t
   recorder.pe = &pred_edge;
   boost::dijkstra_shortest_paths(
       g, s,
-      boost::predecessor_map(boost::make_iterator_property_map(pred.begin(), boost::get(boost::vertex_index, g)))
-          .distance_map(boost::make_iterator_property_map(dist.begin(), boost::get(boost::vertex_index, g)))
+      boost::predecessor_map(
+          boost::make_iterator_property_map(pred.begin(), boost::get(boost::vertex_index, g)))
+          .distance_map(
+              boost::make_iterator_property_map(dist.begin(), boost::get(boost::vertex_index, g)))
           .weight_map(boost::get(&Edge::cost, g))
           .visitor(recorder));
   if (t != s && pred[t] == t) return std::nullopt;
@@ -46,7 +48,8 @@ std::optional<Route> plan_route(const TopologicalMap& map, const Pose2& from, No
   const Node* start = map.node_containing(from.translation());
   if (!start) {
     char buf[96];
-    std::snprintf(buf, sizeof buf, "the pose (%.3f, %.3f) lies in no node's region", from.x(), from.y());
+    std::snprintf(buf, sizeof buf, "the pose (%.3f, %.3f) lies in no node's region", from.x(),
+                  from.y());
     throw Error(buf);
   }
   return plan_route(map, start->id, to);

@@ -12,8 +12,8 @@ using Eigen::Vector2d;
 
 namespace {
 
-const char* const kOrdinals[] = {"first", "second", "third", "fourth", "fifth",
-                                 "sixth", "seventh", "eighth", "ninth", "tenth"};
+const char* const kOrdinals[] = {"first", "second",  "third",  "fourth", "fifth",
+                                 "sixth", "seventh", "eighth", "ninth",  "tenth"};
 
 bool needs_quotes(const std::string& name) {
   if (name.find_first_of(",;()\"\n") != std::string::npos) return true;
@@ -23,7 +23,9 @@ bool needs_quotes(const std::string& name) {
   return padded.find(" and ") != std::string::npos || padded.find(" then ") != std::string::npos;
 }
 
-std::string quoted(const std::string& name) { return needs_quotes(name) ? "\"" + name + "\"" : name; }
+std::string quoted(const std::string& name) {
+  return needs_quotes(name) ? "\"" + name + "\"" : name;
+}
 
 }  // namespace
 
@@ -148,7 +150,8 @@ std::vector<RouteCommand> route_to_commands(const TopologicalMap& map, const Rou
         const Door* target = next && next->place == Place::door ? n.find_door(next->name) : nullptr;
         for (const Door& d : n.doors) {
           if (&d == target) continue;
-          const bool between = forward ? (d.at > s_in && d.at < s_out) : (d.at < s_in && d.at > s_out);
+          const bool between =
+              forward ? (d.at > s_in && d.at < s_out) : (d.at < s_in && d.at > s_out);
           if (between) ++passed.doors(forward ? d.side : flipped(d.side));
         }
         if (target) {

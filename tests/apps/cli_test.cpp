@@ -1,10 +1,10 @@
 // End-to-end tests of the `lampnav` program: exit statuses, stdout and stderr as cli.md says.
 
+#include <sys/wait.h>
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sys/wait.h>
 
 #include "lampnav_test.hpp"
 
@@ -76,18 +76,21 @@ TEST(Cli, RoutePrintsCommands) {
             "turn right at the first corner\n"
             "follow corridor C3\n"
             "stop at door D6 (first door on the left)\n");
-  const Result j = run("route " + src("maps/office_floor.geojson") + " --from 'Lab 1' --to Workshop --json");
+  const Result j =
+      run("route " + src("maps/office_floor.geojson") + " --from 'Lab 1' --to Workshop --json");
   EXPECT_EQ(j.status, 0);
   EXPECT_THAT(j.out, HasSubstr("\"go through door D7\""));
   EXPECT_THAT(j.out, HasSubstr("\"nodes\""));
 }
 
 TEST(Cli, RouteErrors) {
-  const Result unknown = run("route " + src("maps/office_floor.geojson") + " --from E1 --to Nowhere");
+  const Result unknown =
+      run("route " + src("maps/office_floor.geojson") + " --from E1 --to Nowhere");
   EXPECT_EQ(unknown.status, 2);
   EXPECT_THAT(unknown.err, HasSubstr("--to: no node named 'Nowhere'"));
-  const Result none = run("route " + src("tests/fixtures/maps/warnings_unreached_and_dark.geojson") +
-                          " --from C1 --to Lonely");
+  const Result none =
+      run("route " + src("tests/fixtures/maps/warnings_unreached_and_dark.geojson") +
+          " --from C1 --to Lonely");
   EXPECT_EQ(none.status, 1);
   EXPECT_THAT(none.err, HasSubstr("no route from 'C1' to 'Lonely'"));
 }
@@ -104,11 +107,13 @@ TEST(Cli, UsageErrorsExitTwo) {
 }
 
 TEST(Cli, RenderWritesPngAndSvg) {
-  const auto dir = std::filesystem::temp_directory_path() / ("lampnav_render_" + std::to_string(::getpid()));
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("lampnav_render_" + std::to_string(::getpid()));
   std::filesystem::create_directories(dir);
   for (const char* ext : {".png", ".svg"}) {
     const auto out = dir / (std::string("office") + ext);
-    const Result r = run("map render " + src("maps/office_floor.geojson") + " -o '" + out.string() + "'");
+    const Result r =
+        run("map render " + src("maps/office_floor.geojson") + " -o '" + out.string() + "'");
     EXPECT_EQ(r.status, 0) << r.err;
     ASSERT_TRUE(std::filesystem::exists(out));
     EXPECT_GT(std::filesystem::file_size(out), 10000u);
@@ -121,10 +126,12 @@ TEST(Cli, RenderWritesPngAndSvg) {
       EXPECT_THAT(head, HasSubstr("<?xml"));
     }
   }
-  const Result bad = run("map render " + src("maps/office_floor.geojson") + " -o '" + (dir / "x.bmp").string() + "'");
+  const Result bad = run("map render " + src("maps/office_floor.geojson") + " -o '" +
+                         (dir / "x.bmp").string() + "'");
   EXPECT_EQ(bad.status, 2);
   EXPECT_THAT(bad.err, HasSubstr("unknown picture format"));
-  const Result unwritable = run("map render " + src("maps/office_floor.geojson") + " -o /nonexistent/dir/x.png");
+  const Result unwritable =
+      run("map render " + src("maps/office_floor.geojson") + " -o /nonexistent/dir/x.png");
   EXPECT_EQ(unwritable.status, 2);
   std::filesystem::remove_all(dir);
 }

@@ -22,7 +22,9 @@ TEST(Pose2, ComposeKnownValues) {
   const Pose2 b(3, 0, 0);
   EXPECT_THAT(a * b, IsNearPose(Pose2(1, 5, M_PI / 2), 1e-12, 1e-12));
   EXPECT_THAT(a.transform_from(Eigen::Vector2d(1, 0)).eval(),
-              ::testing::Truly([](const Eigen::Vector2d& p) { return (p - Eigen::Vector2d(1, 3)).norm() < 1e-12; }));
+              ::testing::Truly([](const Eigen::Vector2d& p) {
+                return (p - Eigen::Vector2d(1, 3)).norm() < 1e-12;
+              }));
 }
 
 // Property battery: compose/inverse round trips over random poses (manif's style).

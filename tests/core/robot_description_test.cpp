@@ -39,9 +39,10 @@ TEST(RobotDescription, MountRotationIsZYX) {
   const Eigen::Vector3d x = m.rotation() * Eigen::Vector3d::UnitX();
   EXPECT_LT((x - Eigen::Vector3d::UnitY()).norm(), 1e-12);
   m.rpy = {0.1, 0.2, 0.3};
-  const Eigen::Matrix3d expected =
-      (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()) *
-       Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX())).toRotationMatrix();
+  const Eigen::Matrix3d expected = (Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()) *
+                                    Eigen::AngleAxisd(0.2, Eigen::Vector3d::UnitY()) *
+                                    Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitX()))
+                                       .toRotationMatrix();
   EXPECT_LT((m.rotation() - expected).norm(), 1e-12);
 }
 
@@ -82,19 +83,21 @@ INSTANTIATE_TEST_SUITE_P(
                  "wheels.semiaxis", "unknown key"},
         BadRobot{"negative_axis", R"({"name": "r", "wheels": {"semi_axis": -0.2}})", "",
                  "wheels.semi_axis", "greater than zero"},
-        BadRobot{"unknown_model",
-                 R"({"name": "r", "wheels": {"semi_axis": 0.2}, "cameras": [{"name": "c", "model": "fisheye", "width": 1, "height": 1, "mount": {"xyz": [0,0,0], "rpy": [0,0,0]}}]})",
-                 "camera 0 (c)", "model", "unknown camera model"},
+        BadRobot{
+            "unknown_model",
+            R"({"name": "r", "wheels": {"semi_axis": 0.2}, "cameras": [{"name": "c", "model": "fisheye", "width": 1, "height": 1, "mount": {"xyz": [0,0,0], "rpy": [0,0,0]}}]})",
+            "camera 0 (c)", "model", "unknown camera model"},
         BadRobot{"fisheye_key_on_pinhole",
-                 (std::string(R"({"name": "r", "wheels": {"semi_axis": 0.2}, "cameras": [{)") + kCam +
-                  R"(, "fov_deg": 90}]})"),
+                 (std::string(R"({"name": "r", "wheels": {"semi_axis": 0.2}, "cameras": [{)") +
+                  kCam + R"(, "fov_deg": 90}]})"),
                  "camera 0 (c)", "fov_deg", "unknown key"},
-        BadRobot{"zero_width",
-                 R"({"name": "r", "wheels": {"semi_axis": 0.2}, "cameras": [{"name": "c", "model": "pinhole", "width": 0, "height": 288, "fx": 300, "fy": 300, "cx": 1, "cy": 1, "mount": {"xyz": [0,0,0], "rpy": [0,0,0]}}]})",
-                 "camera 0 (c)", "width", "pixel count"},
+        BadRobot{
+            "zero_width",
+            R"({"name": "r", "wheels": {"semi_axis": 0.2}, "cameras": [{"name": "c", "model": "pinhole", "width": 0, "height": 288, "fx": 300, "fy": 300, "cx": 1, "cy": 1, "mount": {"xyz": [0,0,0], "rpy": [0,0,0]}}]})",
+            "camera 0 (c)", "width", "pixel count"},
         BadRobot{"short_distortion",
-                 (std::string(R"({"name": "r", "wheels": {"semi_axis": 0.2}, "cameras": [{)") + kCam +
-                  R"(, "distortion": [0.1, 0.0]}]})"),
+                 (std::string(R"({"name": "r", "wheels": {"semi_axis": 0.2}, "cameras": [{)") +
+                  kCam + R"(, "distortion": [0.1, 0.0]}]})"),
                  "camera 0 (c)", "distortion", "expected 5 elements"}),
     [](const auto& p) { return std::string(p.param.name); });
 

@@ -28,14 +28,14 @@ TEST(CommandParser, EverySentenceOfTheGrammar) {
   const auto cmds = parse_route_commands(
       "Follow corridor C1, turn left at the 2nd junction; go through door D4 then enter hall E.\n"
       "stop at door Lab 3 (second door on the left), stop at the third door on the right, "
-      "stop at end E2, go to Kitchen, enter room \"Tea and Biscuits\", turn right at the next corner");
+      "stop at end E2, go to Kitchen, enter room \"Tea and Biscuits\", turn right at the next "
+      "corner");
   EXPECT_EQ(texts(cmds),
-            (std::vector<std::string>{"follow corridor C1", "turn left at the second junction",
-                                      "go through door D4", "enter hall E",
-                                      "stop at door Lab 3 (second door on the left)",
-                                      "stop at the third door on the right", "stop at end E2",
-                                      "go to Kitchen", "enter room \"Tea and Biscuits\"",
-                                      "turn right at the first corner"}));
+            (std::vector<std::string>{
+                "follow corridor C1", "turn left at the second junction", "go through door D4",
+                "enter hall E", "stop at door Lab 3 (second door on the left)",
+                "stop at the third door on the right", "stop at end E2", "go to Kitchen",
+                "enter room \"Tea and Biscuits\"", "turn right at the first corner"}));
   EXPECT_EQ(cmds[4].target, "Lab 3");
   EXPECT_EQ(cmds[4].ordinal, 2);
   EXPECT_EQ(cmds[4].side, Side::left);
@@ -75,16 +75,22 @@ TEST_P(BadSentenceTest, PointsAtTheWordThatDoesNotFit) {
 INSTANTIATE_TEST_SUITE_P(
     Refusals, BadSentenceTest,
     ::testing::Values(
-        BadSentence{"bad_direction", "turn lft at the first corner", 6, "lft", "\"left\" or \"right\""},
+        BadSentence{"bad_direction", "turn lft at the first corner", 6, "lft",
+                    "\"left\" or \"right\""},
         BadSentence{"bad_ordinal", "turn left at the frist corner", 18, "frist", "ordinal"},
         BadSentence{"wrong_suffix", "turn left at the 2th corner", 18, "2th", "ordinal"},
-        BadSentence{"bad_place", "turn left at the first door", 24, "door", "\"corner\" or \"junction\""},
-        BadSentence{"unknown_verb", "follow corridor C1, jump over the wall", 21, "jump", "\"follow\""},
+        BadSentence{"bad_place", "turn left at the first door", 24, "door",
+                    "\"corner\" or \"junction\""},
+        BadSentence{"unknown_verb", "follow corridor C1, jump over the wall", 21, "jump",
+                    "\"follow\""},
         BadSentence{"missing_name", "follow corridor", 16, "", "corridor name"},
-        BadSentence{"missing_name_before_and", "go through door and enter hall E", 17, "and", "door name"},
+        BadSentence{"missing_name_before_and", "go through door and enter hall E", 17, "and",
+                    "door name"},
         BadSentence{"unclosed_paren", "stop at door D3 (second door on the left", 41, "", "')'"},
-        BadSentence{"bad_side", "stop at the second door on the top", 32, "top", "\"left\" or \"right\""},
-        BadSentence{"trailing_words", "turn left at the first corner please", 31, "please", "end of the command"},
+        BadSentence{"bad_side", "stop at the second door on the top", 32, "top",
+                    "\"left\" or \"right\""},
+        BadSentence{"trailing_words", "turn left at the first corner please", 31, "please",
+                    "end of the command"},
         BadSentence{"unterminated_quote", "go to \"Lab 3", 7, "\"Lab 3", "unterminated"},
         BadSentence{"empty", "  ,  ", 6, "", "no command"}),
     [](const auto& p) { return std::string(p.param.name); });
@@ -94,7 +100,8 @@ TEST(CheckCommands, NamesMustExistWithTheRightPlace) {
   s.corridor("C1", {0, 0}, {10, 0}, {{"Lab 3", Side::left, 4.0}})
       .place("K", Place::corner, {11, 0})
       .place("Hall", Place::hall, {11, 6}, 8);
-  EXPECT_NO_THROW(check_commands(s.map(), parse_route_commands("follow corridor C1, stop at door Lab 3")));
+  EXPECT_NO_THROW(
+      check_commands(s.map(), parse_route_commands("follow corridor C1, stop at door Lab 3")));
   try {
     check_commands(s.map(), parse_route_commands("follow corridor C1, enter hall C1"), "cmd.txt");
     FAIL();

@@ -30,7 +30,8 @@ TEST(Polygon, AreaCentroidContainment) {
 TEST(Polygon, SelfIntersection) {
   EXPECT_FALSE(square(0, 0, 1).self_intersects());
   EXPECT_TRUE(Polygon({{0, 0}, {1, 1}, {1, 0}, {0, 1}}).self_intersects());  // bow tie
-  EXPECT_TRUE(Polygon({{0, 0}, {2, 0}, {2, 2}, {2, 2}, {0, 2}}).self_intersects());  // repeated vertex
+  EXPECT_TRUE(
+      Polygon({{0, 0}, {2, 0}, {2, 2}, {2, 2}, {0, 2}}).self_intersects());  // repeated vertex
   EXPECT_FALSE(Polygon({{0, 0}, {4, 0}, {4, 1}, {1, 1}, {1, 4}, {0, 4}}).self_intersects());
 }
 

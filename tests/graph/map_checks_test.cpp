@@ -38,7 +38,9 @@ TEST(MapChecks, CoverageWarnsAtTheLimitingLamp) {
 
 TEST(MapChecks, OneWayDeadEndIsNotMutuallyReachable) {
   test::MapSketch s;
-  s.place("A", Place::hall, {0, 0}).place("B", Place::hall, {5, 0}).place("C", Place::hall, {10, 0});
+  s.place("A", Place::hall, {0, 0})
+      .place("B", Place::hall, {5, 0})
+      .place("C", Place::hall, {10, 0});
   s.connect("A", "B").connect("B", "C", /*one_way=*/true);
   const auto warnings = check_map(s.map());
   ASSERT_EQ(warnings.size(), 1u);

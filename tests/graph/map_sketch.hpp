@@ -38,10 +38,13 @@ class MapSketch {
     return *this;
   }
   // A place: a square of side `size` centred at c.
-  MapSketch& place(const std::string& name, graph::Place kind, Eigen::Vector2d c, double size = 2.0) {
+  MapSketch& place(const std::string& name, graph::Place kind, Eigen::Vector2d c,
+                   double size = 2.0) {
     graph::Node n = base(name, kind, c);
     const double h = size / 2;
-    n.region = graph::Polygon({{c.x() - h, c.y() - h}, {c.x() + h, c.y() - h}, {c.x() + h, c.y() + h},
+    n.region = graph::Polygon({{c.x() - h, c.y() - h},
+                               {c.x() + h, c.y() - h},
+                               {c.x() + h, c.y() + h},
                                {c.x() - h, c.y() + h}});
     map_.add_node(std::move(n));
     return *this;

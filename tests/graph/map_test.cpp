@@ -1,6 +1,6 @@
+#include <map>
 #include "lampnav/core/error.hpp"
 #include "lampnav/graph/geojson.hpp"
-#include <map>
 
 #include "lampnav_test.hpp"
 #include "map_sketch.hpp"
@@ -76,8 +76,10 @@ TEST(TopologicalMap, LampsAheadAndWithin) {
   s.corridor("C", V(0, 0), V(10, 0), {}, 2.0)  // lamps at x = 1, 3, 5, 7, 9
       .corridor("D", V(0, 5), V(10, 5), {}, 2.0);
   const auto& m = s.map();
-  EXPECT_EQ(ids(m.lamps_ahead(Pose2(3.5, 0, 0), 4.0, 1.0)), (std::vector<std::string>{"C-L3", "C-L4"}));
-  EXPECT_EQ(ids(m.lamps_ahead(Pose2(3.5, 0, M_PI), 10.0, 1.0)), (std::vector<std::string>{"C-L2", "C-L1"}));
+  EXPECT_EQ(ids(m.lamps_ahead(Pose2(3.5, 0, 0), 4.0, 1.0)),
+            (std::vector<std::string>{"C-L3", "C-L4"}));
+  EXPECT_EQ(ids(m.lamps_ahead(Pose2(3.5, 0, M_PI), 10.0, 1.0)),
+            (std::vector<std::string>{"C-L2", "C-L1"}));
   EXPECT_EQ(ids(m.lamps_within(V(5.2, 0), 1.0)), (std::vector<std::string>{"C-L3"}));
   EXPECT_EQ(ids(m.lamps_within(V(5, 2.5), 2.6)), (std::vector<std::string>{"C-L3", "D-L3"}));
   EXPECT_EQ(m.lamps_within(V(50, 0), 3.0).size(), 0u);

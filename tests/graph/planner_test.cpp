@@ -1,6 +1,6 @@
+#include "lampnav/graph/planner.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/graph/geojson.hpp"
-#include "lampnav/graph/planner.hpp"
 #include "lampnav_test.hpp"
 #include "map_sketch.hpp"
 
@@ -17,7 +17,9 @@ std::vector<std::string> names(const TopologicalMap& m, const Route& r) {
 
 TEST(Planner, CheapestNotFewestHops) {
   test::MapSketch s;
-  s.place("A", Place::hall, V(0, 0)).place("B", Place::hall, V(10, 0)).place("C", Place::hall, V(5, 5));
+  s.place("A", Place::hall, V(0, 0))
+      .place("B", Place::hall, V(10, 0))
+      .place("C", Place::hall, V(5, 5));
   s.connect("A", "B", false, 20.0).connect("A", "C", false, 4.0).connect("C", "B", false, 4.0);
   const auto r = plan_route(s.map(), s.id("A"), s.id("B"));
   ASSERT_TRUE(r);

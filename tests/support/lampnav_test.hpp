@@ -21,7 +21,8 @@ inline std::string fixture(const std::string& relative) {
 // Matches a Pose2 within a position tolerance (m) and a yaw tolerance (rad).
 MATCHER_P3(IsNearPose, expected, pos_tol, yaw_tol,
            "is within " + ::testing::PrintToString(pos_tol) + " m and " +
-               ::testing::PrintToString(yaw_tol) + " rad of " + ::testing::PrintToString(expected)) {
+               ::testing::PrintToString(yaw_tol) + " rad of " +
+               ::testing::PrintToString(expected)) {
   const double dp = (arg.translation() - expected.translation()).norm();
   const double dyaw = std::fabs(wrap_angle(arg.yaw() - expected.yaw()));
   *result_listener << "position off by " << dp << " m, yaw by " << dyaw << " rad";

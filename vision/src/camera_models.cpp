@@ -35,7 +35,8 @@ double fold_radius2(const std::array<double, 5>& k) {
 
 PinholeCamera::PinholeCamera(const CameraDescription& d)
     : p_(d.pinhole), width_(d.width), height_(d.height) {
-  if (d.model != CameraModelKind::pinhole) throw Error("camera '" + d.name + "' is not a pinhole camera");
+  if (d.model != CameraModelKind::pinhole)
+    throw Error("camera '" + d.name + "' is not a pinhole camera");
   max_r2_ = fold_radius2(p_.distortion);
 }
 
@@ -121,7 +122,8 @@ std::optional<Vector3d> FisheyeCamera::unproject(const Vector2d& px) const {
   const auto theta = theta_of_radius(std::hypot(dx, dy));
   if (!theta) return std::nullopt;
   const double phi = std::atan2(dy, dx);
-  return Vector3d(std::sin(*theta) * std::cos(phi), std::sin(*theta) * std::sin(phi), std::cos(*theta));
+  return Vector3d(std::sin(*theta) * std::cos(phi), std::sin(*theta) * std::sin(phi),
+                  std::cos(*theta));
 }
 
 bool FisheyeCamera::in_image(const Vector2d& px) const {

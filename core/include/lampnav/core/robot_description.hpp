@@ -26,10 +26,10 @@ struct PinholeParameters {
 
 // Pajdla-Bakstein: r = a tan(theta / b) + c sin(theta / d), valid beyond 90 degrees off-axis.
 struct FisheyeParameters {
-  double u0 = 0, v0 = 0;      // px, image centre
+  double u0 = 0, v0 = 0;  // px, image centre
   double a = 0, b = 1, c = 0, d = 1;
-  double beta = 1.0;          // pixel aspect ratio, applied to the radial term only
-  double fov_deg = 185.0;     // full field of view, deg
+  double beta = 1.0;       // pixel aspect ratio, applied to the radial term only
+  double fov_deg = 185.0;  // full field of view, deg
 };
 
 struct CameraDescription {

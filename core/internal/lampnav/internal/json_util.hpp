@@ -47,10 +47,10 @@ class Cursor {
   // Checks that this is an array, optionally of an exact size or a size range.
   std::size_t array_size(std::size_t min = 0, std::size_t max = SIZE_MAX) const;
 
-  double number() const;        // finite number
-  double positive() const;      // finite and > 0
-  std::int64_t integer() const; // integral number
-  std::string string() const;   // non-empty string
+  double number() const;         // finite number
+  double positive() const;       // finite and > 0
+  std::int64_t integer() const;  // integral number
+  std::string string() const;    // non-empty string
   bool boolean() const;
 
   [[noreturn]] void fail(const std::string& message) const;

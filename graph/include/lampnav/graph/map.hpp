@@ -31,9 +31,9 @@ struct Lamp {
   double yaw = 0.0;                               // rad, direction of the long axis
   bool yaw_given = false;                         // a disc may leave yaw out
   LampShape shape = LampShape::rectangle;
-  double length = 0.0;                            // m, along yaw (a disc: its diameter)
-  double width = 0.0;                             // m (a disc: its diameter)
-  NodeId node;                                    // the node whose sequence holds it
+  double length = 0.0;  // m, along yaw (a disc: its diameter)
+  double width = 0.0;   // m (a disc: its diameter)
+  NodeId node;          // the node whose sequence holds it
 
   // Extent of the lamp along a direction (rad, map frame): what a camera moving that way must fit.
   double extent_along(double direction) const;
@@ -70,8 +70,8 @@ struct Node {
   Eigen::Vector2d point = Eigen::Vector2d::Zero();  // m, the node's Point geometry
   Polygon region;
   std::optional<Axis> axis;
-  std::optional<double> width;           // m
-  std::optional<double> length_override; // m, metadata.length
+  std::optional<double> width;            // m
+  std::optional<double> length_override;  // m, metadata.length
   std::vector<Door> doors;
   std::vector<Lamp> lamps;  // in walking order from the axis' first end (halls: stable order)
 
@@ -83,8 +83,8 @@ struct Node {
 struct Edge {
   EdgeId id;
   NodeId start, end;
-  double cost = 0.0;                    // the effective cost used by planning
-  std::optional<double> cost_given;     // `cost` as written in the file
+  double cost = 0.0;                                   // the effective cost used by planning
+  std::optional<double> cost_given;                    // `cost` as written in the file
   std::vector<std::vector<Eigen::Vector2d>> geometry;  // MultiLineString
   double geometric_length() const;
 };

@@ -24,19 +24,27 @@
 
 namespace lampnav::graph {
 
-enum class CommandKind { follow_corridor, turn, go_through_door, enter, stop_at_node, stop_at_door, go_to };
+enum class CommandKind {
+  follow_corridor,
+  turn,
+  go_through_door,
+  enter,
+  stop_at_node,
+  stop_at_door,
+  go_to
+};
 enum class TurnDirection { left, right };
 
 struct RouteCommand {
   CommandKind kind = CommandKind::follow_corridor;
-  std::string target;        // node or door name; empty for "follow the corridor" and
-                             // "stop at the second door on the left"
-  Place place = Place::corridor;                // turn: corner/junction; enter: hall/room;
-                                                // stop_at_node: the node's place
+  std::string target;             // node or door name; empty for "follow the corridor" and
+                                  // "stop at the second door on the left"
+  Place place = Place::corridor;  // turn: corner/junction; enter: hall/room;
+                                  // stop_at_node: the node's place
   TurnDirection direction = TurnDirection::left;  // turn
-  int ordinal = 0;           // turn: the Nth place of that kind since the previous command;
-                             // stop_at_door: the Nth door on `side` (0: not given)
-  Side side = Side::left;    // stop_at_door, when ordinal > 0
+  int ordinal = 0;         // turn: the Nth place of that kind since the previous command;
+                           // stop_at_door: the Nth door on `side` (0: not given)
+  Side side = Side::left;  // stop_at_door, when ordinal > 0
 
   std::string text() const;
   friend bool operator==(const RouteCommand& a, const RouteCommand& b);
