@@ -34,7 +34,7 @@ test: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
 
 bench: build
-	@cmake --build $(BUILD_DIR) --target benchmarks -j $(JOBS)
+	@cmake --build $(BUILD_DIR) --target benchmarks
 
 format:
 	@git ls-files '*.cpp' '*.hpp' | xargs clang-format -i
