@@ -122,6 +122,7 @@ void draw(cairo_t* cr, const graph::TopologicalMap& map, const View& v, const Dr
     }
   }
   for (const auto& n : map.nodes()) {
+    cairo_new_path(cr);
     cairo_arc(cr, v.px(n.point.x()), v.py(n.point.y()), 3.5, 0, 2 * M_PI);
     cairo_set_source_rgb(cr, 0.15, 0.15, 0.15);
     cairo_fill(cr);
@@ -129,6 +130,7 @@ void draw(cairo_t* cr, const graph::TopologicalMap& map, const View& v, const Dr
   // Lamps at their true size (at least a few pixels).
   for (const auto& n : map.nodes()) {
     for (const auto& l : n.lamps) {
+      cairo_new_path(cr);  // text leaves a current point that would join the shapes
       cairo_save(cr);
       cairo_translate(cr, v.px(l.xyz.x()), v.py(l.xyz.y()));
       cairo_rotate(cr, -l.yaw);  // picture y points down
@@ -183,9 +185,15 @@ void draw(cairo_t* cr, const graph::TopologicalMap& map, const View& v, const Dr
     cairo_show_text(cr, graph::to_string(p));
     lx += 85;
   }
-  const double bar_m = std::pow(10.0, std::floor(std::log10(width_px / 5 / v.scale)));
+  // Scale bar: the longest 1, 2 or 5 times a power of ten that fits a fifth of the width.
+  const double room_m = width_px / 5 / v.scale;
+  const double decade = std::pow(10.0, std::floor(std::log10(room_m)));
+  const double bar_m = room_m >= 5 * decade   ? 5 * decade
+                       : room_m >= 2 * decade ? 2 * decade
+                                              : decade;
   const double bar_px = bar_m * v.scale;
   cairo_set_line_width(cr, 3);
+  cairo_new_path(cr);
   cairo_move_to(cr, width_px - 20 - bar_px, ly);
   cairo_line_to(cr, width_px - 20, ly);
   cairo_stroke(cr);
