@@ -7,7 +7,7 @@ JOBS ?= $(shell nproc)
 LAMPNAV := $(BUILD_DIR)/apps/lampnav
 OUT ?= lampnav-out
 
-.PHONY: all deps configure build demo test bench format clean
+.PHONY: all deps configure build demo test bench format clean interop-deps
 
 all: build
 
@@ -30,7 +30,12 @@ demo: build
 	$(LAMPNAV) route maps/office_floor.geojson --from E1 --to D6
 	@echo "drawings written to $(OUT)/" >&2
 
-test: build
+# The official TypeScript MCAP reader, for the interoperability test (npm registry, pinned by the
+# lock file).
+interop-deps: deps
+	@cd tests/interop && { [ -d node_modules/@mcap/core ] || npm ci --no-audit --no-fund --loglevel=error; }
+
+test: build interop-deps
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
 
 bench: build
