@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   apps::Job run;
   apps::add_map_commands(app, run);
   apps::add_route_command(app, run);
+  apps::add_sim_command(app, run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

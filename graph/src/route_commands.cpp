@@ -225,4 +225,25 @@ std::vector<RouteCommand> route_to_commands(const TopologicalMap& map, const Rou
   return cmds;
 }
 
+std::vector<Vector2d> route_waypoints(const TopologicalMap& map, const Route& route) {
+  std::vector<Vector2d> pts;
+  auto add = [&](const Vector2d& p) {
+    if (pts.empty() || (pts.back() - p).norm() > 1e-6) pts.push_back(p);
+  };
+  const std::size_t k = route.nodes.size();
+  for (std::size_t i = 0; i < k; ++i) {
+    const Node& n = map.node(route.nodes[i]);
+    const Node* prev = i > 0 ? &map.node(route.nodes[i - 1]) : nullptr;
+    const Node* next = i + 1 < k ? &map.node(route.nodes[i + 1]) : nullptr;
+    if (n.place == Place::corridor && n.axis) {
+      const double here = std::clamp(n.axis->along(n.point), 0.0, n.axis->length());
+      add(n.axis->point_at(prev ? meeting_point(n, *prev) : here));
+      add(n.axis->point_at(next ? meeting_point(n, *next) : here));
+    } else {
+      add(n.point);
+    }
+  }
+  return pts;
+}
+
 }  // namespace lampnav::graph

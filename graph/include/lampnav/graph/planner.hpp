@@ -22,4 +22,9 @@ std::optional<Route> plan_route(const TopologicalMap& map, NodeId from, NodeId t
 // lies in no region.
 std::optional<Route> plan_route(const TopologicalMap& map, const Pose2& from, NodeId to);
 
+// The floor points a robot passes through to drive a route: along each corridor's axis from where
+// it comes in to where it leaves (an axis end, or a door's place along it), through the points of
+// the other places. Consecutive duplicates are dropped.
+std::vector<Eigen::Vector2d> route_waypoints(const TopologicalMap& map, const Route& route);
+
 }  // namespace lampnav::graph

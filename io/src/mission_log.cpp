@@ -1,0 +1,333 @@
+#include "lampnav/io/mission_log.hpp"
+
+#include <array>
+#include <cmath>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "lampnav/core/error.hpp"
+
+namespace lampnav::io {
+
+using Json = nlohmann::ordered_json;
+
+// ---------------------------------------------------------------------------------------------
+// Base64 and images.
+
+namespace {
+constexpr char kB64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+}
+
+std::string base64_encode(const std::string& bytes) {
+  std::string out;
+  out.reserve((bytes.size() + 2) / 3 * 4);
+  std::size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    const unsigned v = (static_cast<unsigned char>(bytes[i]) << 16) |
+                       (static_cast<unsigned char>(bytes[i + 1]) << 8) |
+                       static_cast<unsigned char>(bytes[i + 2]);
+    out += kB64[(v >> 18) & 63];
+    out += kB64[(v >> 12) & 63];
+    out += kB64[(v >> 6) & 63];
+    out += kB64[v & 63];
+  }
+  if (i < bytes.size()) {
+    unsigned v = static_cast<unsigned char>(bytes[i]) << 16;
+    if (i + 1 < bytes.size()) v |= static_cast<unsigned char>(bytes[i + 1]) << 8;
+    out += kB64[(v >> 18) & 63];
+    out += kB64[(v >> 12) & 63];
+    out += i + 1 < bytes.size() ? kB64[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+std::string base64_decode(const std::string& text) {
+  static const auto table = [] {
+    std::array<int, 256> t{};
+    t.fill(-1);
+    for (int i = 0; i < 64; ++i) t[static_cast<unsigned char>(kB64[i])] = i;
+    return t;
+  }();
+  if (text.size() % 4 != 0)
+    throw std::invalid_argument("length " + std::to_string(text.size()) +
+                                " is not a multiple of 4");
+  std::string out;
+  out.reserve(text.size() / 4 * 3);
+  for (std::size_t i = 0; i < text.size(); i += 4) {
+    int v[4];
+    int pad = 0;
+    for (int k = 0; k < 4; ++k) {
+      const char c = text[i + k];
+      if (c == '=' && i + 4 == text.size() && k >= 2) {
+        v[k] = 0;
+        ++pad;
+        continue;
+      }
+      if (pad > 0 || table[static_cast<unsigned char>(c)] < 0) {
+        throw std::invalid_argument("bad character at " + std::to_string(i + k));
+      }
+      v[k] = table[static_cast<unsigned char>(c)];
+    }
+    const unsigned n = (v[0] << 18) | (v[1] << 12) | (v[2] << 6) | v[3];
+    out += static_cast<char>((n >> 16) & 0xff);
+    if (pad < 2) out += static_cast<char>((n >> 8) & 0xff);
+    if (pad < 1) out += static_cast<char>(n & 0xff);
+  }
+  return out;
+}
+
+std::string encode_png(const Image8& image, int compression) {
+  const cv::Mat m(image.height, image.width, CV_8UC1,
+                  const_cast<std::uint8_t*>(image.pixels.data()));
+  std::vector<uchar> buf;
+  cv::imencode(".png", m, buf, {cv::IMWRITE_PNG_COMPRESSION, compression});
+  return std::string(buf.begin(), buf.end());
+}
+
+Image8 decode_image(const std::string& bytes, const std::string& source) {
+  if (bytes.empty()) throw InputError({source, "", ""}, "empty image");
+  const std::vector<uchar> buf(bytes.begin(), bytes.end());
+  cv::Mat m;
+  try {
+    m = cv::imdecode(buf, cv::IMREAD_UNCHANGED);
+  } catch (const cv::Exception& e) {
+    throw InputError({source, "", ""}, std::string("image does not decode: ") + e.what());
+  }
+  if (m.empty())
+    throw InputError({source, "", ""}, "image does not decode (not PNG or JPEG, or damaged)");
+  if (m.depth() == CV_16U) m.convertTo(m, CV_8U, 1.0 / 257.0);
+  if (m.depth() != CV_8U)
+    throw InputError({source, "", ""}, "unsupported image depth (8 or 16 bits per channel)");
+  if (m.channels() == 3) cv::cvtColor(m, m, cv::COLOR_BGR2GRAY);
+  if (m.channels() == 4) cv::cvtColor(m, m, cv::COLOR_BGRA2GRAY);
+  Image8 out(m.cols, m.rows);
+  for (int y = 0; y < m.rows; ++y)
+    std::copy_n(m.ptr<std::uint8_t>(y), m.cols, &out.pixels[static_cast<std::size_t>(y) * m.cols]);
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writer.
+
+namespace {
+
+Json stamp_json(Stamp t) {
+  const std::int64_t ns = to_nanoseconds(t);
+  std::int64_t sec = ns / 1'000'000'000;
+  std::int64_t nsec = ns % 1'000'000'000;
+  if (nsec < 0) {
+    nsec += 1'000'000'000;
+    --sec;
+  }
+  return Json{{"sec", sec}, {"nsec", nsec}};
+}
+
+const char* const kTimeSchema =
+    R"("timestamp": {"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer", "minimum": 0}}})";
+
+struct ChannelSpec {
+  const char* topic;
+  const char* schema_name;
+  std::string schema;
+};
+
+std::vector<ChannelSpec> channel_specs() {
+  const std::string t = kTimeSchema;
+  return {
+      {topics::kWheels, "lampnav.WheelOdometry",
+       R"({"type": "object", "properties": {)" + t +
+           R"(, "left": {"type": "number"}, "right": {"type": "number"}}})"},
+      {topics::kCeilingImage, "foxglove.CompressedImage",
+       R"({"type": "object", "properties": {)" + t +
+           R"(, "frame_id": {"type": "string"}, "data": {"type": "string", "contentEncoding": "base64"}, "format": {"type": "string"}}})"},
+      {topics::kOmniImage, "foxglove.CompressedImage",
+       R"({"type": "object", "properties": {)" + t +
+           R"(, "frame_id": {"type": "string"}, "data": {"type": "string", "contentEncoding": "base64"}, "format": {"type": "string"}}})"},
+      {topics::kTruth, "foxglove.PoseInFrame",
+       R"({"type": "object", "properties": {)" + t +
+           R"(, "frame_id": {"type": "string"}, "pose": {"type": "object", "properties": {"position": {"type": "object"}, "orientation": {"type": "object"}}}}})"},
+      {topics::kEvents, "lampnav.Event",
+       R"({"type": "object", "properties": {)" + t +
+           R"(, "kind": {"type": "string"}, "detail": {"type": "string"}}})"},
+      {topics::kCommands, "lampnav.Command",
+       R"({"type": "object", "properties": {)" + t + R"(, "text": {"type": "string"}}})"},
+  };
+}
+
+}  // namespace
+
+struct MissionLogWriter::Impl {
+  McapWriter w;
+  std::map<std::string, std::uint16_t> channels;
+  std::map<std::string, std::uint16_t> schemas;
+  explicit Impl(const std::string& path, McapWriterOptions o) : w(path, std::move(o)) {}
+
+  std::uint16_t channel(const std::string& topic) {
+    auto it = channels.find(topic);
+    if (it != channels.end()) return it->second;
+    for (const auto& spec : channel_specs()) {
+      if (topic != spec.topic) continue;
+      auto s = schemas.find(spec.schema_name);
+      if (s == schemas.end())
+        s = schemas
+                .emplace(spec.schema_name,
+                         w.add_schema(spec.schema_name, "jsonschema", spec.schema))
+                .first;
+      return channels[topic] = w.add_channel(s->second, topic, "json");
+    }
+    throw Error("no mission-log channel for topic " + topic);
+  }
+  void put(const std::string& topic, Stamp available, Stamp captured, const Json& j) {
+    const std::uint16_t ch = channel(topic);
+    w.write(ch, static_cast<std::uint64_t>(std::max<std::int64_t>(0, to_nanoseconds(available))),
+            static_cast<std::uint64_t>(std::max<std::int64_t>(0, to_nanoseconds(captured))),
+            j.dump());
+  }
+};
+
+MissionLogWriter::MissionLogWriter(const std::string& path, McapWriterOptions options)
+    : impl_(std::make_unique<Impl>(path, std::move(options))) {}
+MissionLogWriter::~MissionLogWriter() = default;
+
+void MissionLogWriter::attach_robot(const std::string& robot_json) {
+  impl_->w.attach({0, 0, "robot.json", "application/json", robot_json});
+}
+void MissionLogWriter::attach_map(const std::string& map_geojson) {
+  impl_->w.attach({0, 0, "map.geojson", "application/geo+json", map_geojson});
+}
+void MissionLogWriter::write(Stamp available, const WheelReading& r) {
+  impl_->put(topics::kWheels, available, r.stamp,
+             Json{{"timestamp", stamp_json(r.stamp)}, {"left", r.left}, {"right", r.right}});
+}
+void MissionLogWriter::write_image(Stamp available, const ImageFrame& f) {
+  const std::string topic =
+      f.frame_id == "omni_camera" ? topics::kOmniImage : topics::kCeilingImage;
+  impl_->put(topic, available, f.stamp,
+             Json{{"timestamp", stamp_json(f.stamp)},
+                  {"frame_id", f.frame_id},
+                  {"format", f.format},
+                  {"data", base64_encode(f.data)}});
+}
+void MissionLogWriter::write(Stamp available, const TruthPose& t) {
+  const double h = t.pose.yaw() / 2;
+  impl_->put(
+      topics::kTruth, available, t.stamp,
+      Json{{"timestamp", stamp_json(t.stamp)},
+           {"frame_id", "map"},
+           {"pose",
+            {{"position", {{"x", t.pose.x()}, {"y", t.pose.y()}, {"z", 0.0}}},
+             {"orientation", {{"x", 0.0}, {"y", 0.0}, {"z", std::sin(h)}, {"w", std::cos(h)}}}}}});
+}
+void MissionLogWriter::write(Stamp available, const MissionEvent& e) {
+  impl_->put(topics::kEvents, available, e.stamp,
+             Json{{"timestamp", stamp_json(e.stamp)}, {"kind", e.kind}, {"detail", e.detail}});
+}
+void MissionLogWriter::write(Stamp available, const CommandMessage& c) {
+  impl_->put(topics::kCommands, available, c.stamp,
+             Json{{"timestamp", stamp_json(c.stamp)}, {"text", c.text}});
+}
+void MissionLogWriter::close() { impl_->w.close(); }
+
+// ---------------------------------------------------------------------------------------------
+// Reader.
+
+namespace {
+
+struct BadMessage : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+const Json& member(const Json& j, const char* key) {
+  auto it = j.find(key);
+  if (it == j.end()) throw BadMessage(std::string("missing \"") + key + "\"");
+  return *it;
+}
+double number(const Json& j, const char* key) {
+  const Json& v = member(j, key);
+  if (!v.is_number() || !std::isfinite(v.get<double>()))
+    throw BadMessage(std::string("\"") + key + "\" is not a finite number");
+  return v.get<double>();
+}
+std::string text(const Json& j, const char* key) {
+  const Json& v = member(j, key);
+  if (!v.is_string()) throw BadMessage(std::string("\"") + key + "\" is not a string");
+  return v.get<std::string>();
+}
+Stamp stamp(const Json& j) {
+  const Json& t = member(j, "timestamp");
+  const Json& s = member(t, "sec");
+  const Json& n = member(t, "nsec");
+  if (!s.is_number_integer() || !n.is_number_integer())
+    throw BadMessage("timestamp sec/nsec must be integers");
+  const std::int64_t nsec = n.get<std::int64_t>();
+  if (nsec < 0 || nsec >= 1'000'000'000) throw BadMessage("timestamp nsec must be in [0, 1e9)");
+  return stamp_from_nanoseconds(s.get<std::int64_t>() * 1'000'000'000 + nsec);
+}
+ImageFrame image(const Json& j) {
+  ImageFrame f;
+  f.stamp = stamp(j);
+  f.frame_id = text(j, "frame_id");
+  f.format = text(j, "format");
+  if (f.format != "png" && f.format != "jpeg" && f.format != "jpg")
+    throw BadMessage("image format \"" + f.format + "\" is not png or jpeg");
+  try {
+    f.data = base64_decode(text(j, "data"));
+  } catch (const std::invalid_argument& e) {
+    throw BadMessage(std::string("\"data\" is not base64: ") + e.what());
+  }
+  return f;
+}
+
+}  // namespace
+
+MissionLog read_mission_log(const std::string& path) {
+  McapFile f = read_mcap(path);
+  MissionLog log;
+  log.report = f.report;
+  if (const auto* a = f.attachment("robot.json")) log.robot_json = a->data;
+  if (const auto* a = f.attachment("map.geojson")) log.map_geojson = a->data;
+  for (const McapMessage& m : f.messages) {
+    const McapChannel* ch = f.channel(m.channel_id);
+    const Stamp avail = stamp_from_nanoseconds(static_cast<std::int64_t>(m.log_time));
+    try {
+      Json j;
+      try {
+        j = Json::parse(m.data);
+      } catch (const Json::parse_error& e) {
+        throw BadMessage(std::string("bad JSON: ") + e.what());
+      }
+      if (!j.is_object()) throw BadMessage("not a JSON object");
+      const std::string& topic = ch->topic;
+      if (topic == topics::kWheels) {
+        log.wheels.push_back({avail, {stamp(j), number(j, "left"), number(j, "right")}});
+      } else if (topic == topics::kCeilingImage) {
+        log.ceiling_images.push_back({avail, image(j)});
+      } else if (topic == topics::kOmniImage) {
+        log.omni_images.push_back({avail, image(j)});
+      } else if (topic == topics::kTruth) {
+        const Json& pose = member(j, "pose");
+        const Json& p = member(pose, "position");
+        const Json& q = member(pose, "orientation");
+        const double yaw = 2.0 * std::atan2(number(q, "z"), number(q, "w"));
+        log.truth.push_back({avail, {stamp(j), Pose2(number(p, "x"), number(p, "y"), yaw)}});
+      } else if (topic == topics::kEvents) {
+        log.events.push_back(
+            {avail, {stamp(j), text(j, "kind"), j.contains("detail") ? text(j, "detail") : ""}});
+      } else if (topic == topics::kCommands) {
+        log.commands.push_back({avail, {stamp(j), text(j, "text")}});
+      }
+      // Other topics (a replay's own outputs, a user's extras) are not inputs: left alone.
+    } catch (const BadMessage& e) {
+      ++log.skipped_messages;
+      log.problems.push_back(ch->topic + " message " + std::to_string(m.sequence) + ": " +
+                             e.what() + " (skipped)");
+    }
+  }
+  return log;
+}
+
+}  // namespace lampnav::io
