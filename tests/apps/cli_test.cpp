@@ -138,3 +138,34 @@ TEST(Cli, RenderWritesPngAndSvg) {
 
 }  // namespace
 }  // namespace lampnav
+
+namespace lampnav {
+namespace {
+
+TEST(Cli, SimRecordsARouteAndRefusesBadInput) {
+  const auto out = std::filesystem::temp_directory_path() /
+                   ("lampnav_cli_sim_" + std::to_string(::getpid()) + ".mcap");
+  const Result r = run("sim --map " + src("maps/office_floor.geojson") + " --robot " +
+                       src("maps/robots/pioneer.json") + " --route 'D1 -> D2' --seed 7 -q -o '" +
+                       out.string() + "'");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out, HasSubstr("arrived"));
+  EXPECT_GT(std::filesystem::file_size(out), 10000u);
+  std::filesystem::remove(out);
+  const Result unknown = run("sim --scenario nowhere -o '" + out.string() + "'");
+  EXPECT_EQ(unknown.status, 2);
+  EXPECT_THAT(unknown.err, HasSubstr("unknown scenario 'nowhere'"));
+  const Result bad_route =
+      run("sim --map " + src("maps/office_floor.geojson") + " --robot " +
+          src("maps/robots/pioneer.json") + " --route 'D1 to D2' -o '" + out.string() + "'");
+  EXPECT_EQ(bad_route.status, 2);
+  EXPECT_THAT(bad_route.err, HasSubstr("--route"));
+  const Result bad_lamp = run("sim --scenario corridor --fail-lamp NOPE -o '" + out.string() + "'");
+  EXPECT_EQ(bad_lamp.status, 2);
+  EXPECT_THAT(bad_lamp.err, HasSubstr("no lamp 'NOPE'"));
+  const Result both = run("sim -o x.mcap");
+  EXPECT_EQ(both.status, 2);
+}
+
+}  // namespace
+}  // namespace lampnav
