@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <optional>
 
 #include "commands.hpp"
 #include "lampnav/graph/geojson.hpp"
@@ -25,6 +26,7 @@ struct SimArgs {
   std::uint64_t seed = 1;
   bool no_bumps = false, quiet = false;
   double bump_deg = 0.5;
+  std::optional<double> ceiling_delay, omni_delay;
 };
 
 std::string data_path(const std::string& relative) {
@@ -71,6 +73,8 @@ int run_sim(const SimArgs& a) {
             [](const auto& x, const auto& y) { return x.at_s < y.at_s; });
   for (const auto& id : a.failed_lamps) s.failed_lamps.insert(id);
   s.bump_sigma_rad = a.no_bumps ? 0.0 : a.bump_deg * M_PI / 180.0;
+  if (a.ceiling_delay) s.ceiling_delay_s = *a.ceiling_delay;
+  if (a.omni_delay) s.omni_delay_s = *a.omni_delay;
 
   const bool show = !a.quiet && ::isatty(2);
   const auto start = std::chrono::steady_clock::now();
@@ -120,6 +124,12 @@ void add_sim_command(CLI::App& app, Job& run) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 10.0));
   cmd->add_flag("--no-bumps", a->no_bumps, "Turn floor bumps off");
+  cmd->add_option("--ceiling-delay", a->ceiling_delay,
+                  "Ceiling camera capture-to-availability delay (s, default 1)")
+      ->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--omni-delay", a->omni_delay,
+                  "Omni camera capture-to-availability delay (s, default 0.5)")
+      ->check(CLI::Range(0.0, 10.0));
   cmd->add_flag("-q,--quiet", a->quiet, "No progress bar");
   cmd->add_option("-o,--output", a->out, "Mission log to write (.mcap)")->required();
   cmd->callback([a, &run] { run = [a] { return run_sim(*a); }; });
