@@ -24,15 +24,8 @@ Result run(const std::string& args) {
   const std::string err_file = (dir / ("lampnav_cli_err_" + std::to_string(::getpid()))).string();
   const std::string cmd = std::string(LAMPNAV_BINARY) + " " + args + " 2>" + err_file;
   Result r;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (!p) return r;
-  std::array<char, 4096> buf;
-  std::size_t n;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  const int st = ::pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  std::ifstream in(err_file);
-  r.err.assign(std::istreambuf_iterator<char>(in), {});
+  r.out = test::run_command(cmd, &r.status);
+  r.err = test::slurp(err_file);
   std::filesystem::remove(err_file);
   return r;
 }

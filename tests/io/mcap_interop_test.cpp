@@ -16,16 +16,7 @@ using ::testing::HasSubstr;
 
 std::string run_node_reader(const std::string& file, int* status) {
   const std::string dir = test::source_path("tests/interop");
-  const std::string cmd = "cd '" + dir + "' && node read_mcap.mjs '" + file + "' 2>&1";
-  std::string out;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (!p) return out;
-  std::array<char, 4096> buf;
-  std::size_t n;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
-  const int st = ::pclose(p);
-  *status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  return out;
+  return test::run_command("cd '" + dir + "' && node read_mcap.mjs '" + file + "' 2>&1", status);
 }
 
 class McapInterop : public ::testing::TestWithParam<McapCompression> {};

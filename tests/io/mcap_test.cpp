@@ -18,12 +18,7 @@ std::string temp_file(const std::string& name) {
       .string();
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::slurp;
 
 // Writes a small mission-like file: two channels, interleaved messages, two attachments.
 std::string write_sample(const std::string& name, McapWriterOptions opt, int messages = 40) {

@@ -19,12 +19,10 @@ using ::testing::HasSubstr;
 TEST(MissionInterop, OfficialReaderOpensASimulatedMission) {
   ASSERT_TRUE(std::filesystem::exists(test::source_path("tests/interop/node_modules/@mcap/core")))
       << "@mcap/core is not installed: run `make test`, which installs it";
-  std::ifstream in(test::source_path("maps/office_floor.geojson"));
-  std::stringstream text;
-  text << in.rdbuf();
-  const auto map = graph::parse_map(text.str(), "office");
+  const std::string text = test::slurp(test::source_path("maps/office_floor.geojson"));
+  const auto map = graph::parse_map(text, "office");
   const auto robot = read_robot_description(test::source_path("maps/robots/pioneer.json"));
-  Scenario s = make_route_scenario(map.map, text.str(), robot, "D1", "D2", 9);
+  Scenario s = make_route_scenario(map.map, text, robot, "D1", "D2", 9);
   s.frame_drop_probability = 0;
   s.kidnaps.push_back({5.0, std::nullopt});
   const std::string path = (std::filesystem::temp_directory_path() /
@@ -33,14 +31,9 @@ TEST(MissionInterop, OfficialReaderOpensASimulatedMission) {
   const RecordStats st = record_mission(s, path);
   const std::string cmd =
       "cd '" + test::source_path("tests/interop") + "' && node read_mcap.mjs '" + path + "' 2>&1";
-  std::string out;
-  FILE* p = ::popen(cmd.c_str(), "r");
-  ASSERT_NE(p, nullptr);
-  std::array<char, 4096> buf;
-  std::size_t n;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
-  const int status = ::pclose(p);
-  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << out;
+  int status = -1;
+  const std::string out = test::run_command(cmd, &status);
+  ASSERT_EQ(status, 0) << out;
   const std::string wheels = std::to_string(st.wheel_messages);
   EXPECT_THAT(
       out, HasSubstr(R"("/wheels":{"schema":"lampnav.WheelOdometry","encoding":"json","count":)" +
@@ -65,7 +58,7 @@ TEST(MissionInterop, OfficialReaderOpensASimulatedMission) {
   EXPECT_THAT(out, HasSubstr(R"("logTimeOrdered":true)"));
   EXPECT_THAT(out, HasSubstr(R"({"name":"robot.json","mediaType":"application/json")"));
   EXPECT_THAT(out, HasSubstr(R"({"name":"map.geojson","mediaType":"application/geo+json","size":)" +
-                             std::to_string(text.str().size()) + "}"));
+                             std::to_string(text.size()) + "}"));
   std::filesystem::remove(path);
 }
 

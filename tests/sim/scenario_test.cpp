@@ -10,12 +10,7 @@
 namespace lampnav::sim {
 namespace {
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using test::slurp;
 
 struct Office {
   std::string text = slurp(test::source_path("maps/office_floor.geojson"));

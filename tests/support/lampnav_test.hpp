@@ -4,7 +4,13 @@
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <sys/wait.h>
+
+#include <array>
 #include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <string>
 
 #include "lampnav/core/pose2.hpp"
@@ -16,6 +22,29 @@ inline std::string source_path(const std::string& relative) {
 }
 inline std::string fixture(const std::string& relative) {
   return source_path("tests/fixtures/" + relative);
+}
+
+// The whole content of a file ("" when it cannot be read).
+inline std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Runs a shell command; returns what it printed on stdout and sets *status to its exit status
+// (-1 when it did not exit normally).
+inline std::string run_command(const std::string& command, int* status) {
+  std::string out;
+  *status = -1;
+  FILE* p = ::popen(command.c_str(), "r");
+  if (!p) return out;
+  std::array<char, 4096> buf;
+  std::size_t n;
+  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) out.append(buf.data(), n);
+  const int st = ::pclose(p);
+  *status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  return out;
 }
 
 // Matches a Pose2 within a position tolerance (m) and a yaw tolerance (rad).
