@@ -32,19 +32,16 @@ int run_check(const CheckArgs& a) {
     const RobotDescription robot = read_robot_description(a.robot);
     const CameraDescription* cam = robot.find_camera(a.camera);
     if (!cam) throw InputError({a.robot, "", "cameras"}, "no camera named '" + a.camera + "'");
-    graph::MapCheckOptions opts;
     graph::CeilingCoverage cov;
     cov.view_length = [cam](double h) { return vision::ceiling_view_length(*cam, h); };
     cov.speed = a.speed;
     cov.frame_rate = a.fps;
-    opts.coverage = cov;
-    const auto all = graph::check_map(loaded.map, opts, a.map);
-    const std::size_t extra = all.size() - warnings.size();
-    warnings = all;
+    const auto coverage = graph::check_camera_coverage(loaded.map, cov, a.map);
+    warnings.insert(warnings.end(), coverage.begin(), coverage.end());
     char buf[160];
     std::snprintf(buf, sizeof buf, "camera coverage (%s at %.2f m/s, %.2f frames/s): %s",
                   a.camera.c_str(), a.speed, a.fps,
-                  extra == 0 ? "every lamp seen" : "see warnings");
+                  coverage.empty() ? "every lamp seen" : "see warnings");
     coverage_line = buf;
   }
   for (const auto& w : warnings) diagnostic("warning", w.text());

@@ -27,6 +27,41 @@ std::string fmt(double v) {
 }
 }  // namespace
 
+std::vector<MapWarning> check_camera_coverage(const TopologicalMap& map, const CeilingCoverage& cov,
+                                              const std::string& file) {
+  std::vector<MapWarning> out;
+  const Graph& g = map.impl().g;
+  const std::size_t n = boost::num_vertices(g);
+  for (std::size_t v = 0; v < n; ++v) {
+    const Node& node = g[v];
+    if (node.place != Place::corridor || !node.axis || node.lamps.empty()) continue;
+    const double heading = std::atan2(node.axis->direction().y(), node.axis->direction().x());
+    double worst = INFINITY;
+    std::size_t worst_i = 0;
+    for (std::size_t i = 0; i < node.lamps.size(); ++i) {
+      const Lamp& l = node.lamps[i];
+      double spacing = INFINITY;
+      if (i + 1 < node.lamps.size()) spacing = (node.lamps[i + 1].xyz - l.xyz).head<2>().norm();
+      if (i > 0) spacing = std::min(spacing, (node.lamps[i - 1].xyz - l.xyz).head<2>().norm());
+      const double vmax = max_speed_every_lamp_seen(
+          cov.view_length(l.xyz.z()), l.extent_along(heading), spacing, cov.frame_rate);
+      if (vmax < worst) {
+        worst = vmax;
+        worst_i = i;
+      }
+    }
+    if (worst < cov.speed) {
+      out.push_back(
+          {{file, node_place(node), "properties.metadata.lamps[" + std::to_string(worst_i) + "]"},
+           "at " + fmt(cov.speed) + " m/s and " + fmt(cov.frame_rate) +
+               " frames/s the ceiling camera could miss or confuse lamp '" +
+               node.lamps[worst_i].id.value + "'; the highest safe speed here is " + fmt(worst) +
+               " m/s"});
+    }
+  }
+  return out;
+}
+
 std::vector<MapWarning> check_map(const TopologicalMap& map, const MapCheckOptions& options,
                                   const std::string& file) {
   std::vector<MapWarning> out;
@@ -64,34 +99,8 @@ std::vector<MapWarning> check_map(const TopologicalMap& map, const MapCheckOptio
     }
   }
   if (options.coverage) {
-    const CeilingCoverage& cov = *options.coverage;
-    for (std::size_t v = 0; v < n; ++v) {
-      const Node& node = g[v];
-      if (node.place != Place::corridor || !node.axis || node.lamps.empty()) continue;
-      const double heading = std::atan2(node.axis->direction().y(), node.axis->direction().x());
-      double worst = INFINITY;
-      std::size_t worst_i = 0;
-      for (std::size_t i = 0; i < node.lamps.size(); ++i) {
-        const Lamp& l = node.lamps[i];
-        double spacing = INFINITY;
-        if (i + 1 < node.lamps.size()) spacing = (node.lamps[i + 1].xyz - l.xyz).head<2>().norm();
-        if (i > 0) spacing = std::min(spacing, (node.lamps[i - 1].xyz - l.xyz).head<2>().norm());
-        const double vmax = max_speed_every_lamp_seen(
-            cov.view_length(l.xyz.z()), l.extent_along(heading), spacing, cov.frame_rate);
-        if (vmax < worst) {
-          worst = vmax;
-          worst_i = i;
-        }
-      }
-      if (worst < cov.speed) {
-        out.push_back(
-            {{file, node_place(node), "properties.metadata.lamps[" + std::to_string(worst_i) + "]"},
-             "at " + fmt(cov.speed) + " m/s and " + fmt(cov.frame_rate) +
-                 " frames/s the ceiling camera could miss or confuse lamp '" +
-                 node.lamps[worst_i].id.value + "'; the highest safe speed here is " + fmt(worst) +
-                 " m/s"});
-      }
-    }
+    const auto coverage = check_camera_coverage(map, *options.coverage, file);
+    out.insert(out.end(), coverage.begin(), coverage.end());
   }
   return out;
 }

@@ -4,6 +4,7 @@
 #include <boost/graph/dijkstra_shortest_paths.hpp>
 #include <cstdio>
 
+#include "corridor_geometry.hpp"
 #include "lampnav/core/error.hpp"
 #include "map_impl.hpp"
 
@@ -53,6 +54,28 @@ std::optional<Route> plan_route(const TopologicalMap& map, const Pose2& from, No
     throw Error(buf);
   }
   return plan_route(map, start->id, to);
+}
+
+using Eigen::Vector2d;
+
+std::vector<Vector2d> route_waypoints(const TopologicalMap& map, const Route& route) {
+  std::vector<Vector2d> pts;
+  auto add = [&](const Vector2d& p) {
+    if (pts.empty() || (pts.back() - p).norm() > 1e-6) pts.push_back(p);
+  };
+  const std::size_t k = route.nodes.size();
+  for (std::size_t i = 0; i < k; ++i) {
+    const Node& n = map.node(route.nodes[i]);
+    const Node* prev = i > 0 ? &map.node(route.nodes[i - 1]) : nullptr;
+    const Node* next = i + 1 < k ? &map.node(route.nodes[i + 1]) : nullptr;
+    if (n.place == Place::corridor && n.axis) {
+      add(n.axis->point_at(entry_point(n, prev)));
+      add(n.axis->point_at(entry_point(n, next)));
+    } else {
+      add(n.point);
+    }
+  }
+  return pts;
 }
 
 }  // namespace lampnav::graph

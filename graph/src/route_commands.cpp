@@ -4,6 +4,7 @@
 #include <cctype>
 #include <cmath>
 
+#include "corridor_geometry.hpp"
 #include "lampnav/graph/geometry.hpp"
 
 namespace lampnav::graph {
@@ -92,19 +93,6 @@ Vector2d far_anchor(const Node& n, const Vector2d& p) {
   return (n.axis->first - p).norm() > (n.axis->second - p).norm() ? n.axis->first : n.axis->second;
 }
 
-// The distance along a corridor's axis at which the neighbouring node `other` meets it: a door
-// listed in the corridor at its `at`, a door node elsewhere at the foot of its point, anything
-// else at the nearer axis end.
-double meeting_point(const Node& corridor, const Node& other) {
-  const Axis& ax = *corridor.axis;
-  if (other.place == Place::door) {
-    if (const Door* d = corridor.find_door(other.name)) return d->at;
-    const double s = ax.along(other.point);
-    if (s > 0 && s < ax.length()) return s;
-  }
-  return (other.point - ax.first).norm() <= (other.point - ax.second).norm() ? 0.0 : ax.length();
-}
-
 Side flipped(Side s) { return s == Side::left ? Side::right : Side::left; }
 
 struct Passed {
@@ -143,9 +131,8 @@ std::vector<RouteCommand> route_to_commands(const TopologicalMap& map, const Rou
         }
         continuing = false;
         if (!n.axis) break;
-        const double here = std::clamp(n.axis->along(n.point), 0.0, n.axis->length());
-        const double s_in = prev ? meeting_point(n, *prev) : here;
-        const double s_out = next ? meeting_point(n, *next) : here;
+        const double s_in = entry_point(n, prev);
+        const double s_out = entry_point(n, next);
         const bool forward = s_out >= s_in;
         const Door* target = next && next->place == Place::door ? n.find_door(next->name) : nullptr;
         for (const Door& d : n.doors) {
@@ -223,27 +210,6 @@ std::vector<RouteCommand> route_to_commands(const TopologicalMap& map, const Rou
     }
   }
   return cmds;
-}
-
-std::vector<Vector2d> route_waypoints(const TopologicalMap& map, const Route& route) {
-  std::vector<Vector2d> pts;
-  auto add = [&](const Vector2d& p) {
-    if (pts.empty() || (pts.back() - p).norm() > 1e-6) pts.push_back(p);
-  };
-  const std::size_t k = route.nodes.size();
-  for (std::size_t i = 0; i < k; ++i) {
-    const Node& n = map.node(route.nodes[i]);
-    const Node* prev = i > 0 ? &map.node(route.nodes[i - 1]) : nullptr;
-    const Node* next = i + 1 < k ? &map.node(route.nodes[i + 1]) : nullptr;
-    if (n.place == Place::corridor && n.axis) {
-      const double here = std::clamp(n.axis->along(n.point), 0.0, n.axis->length());
-      add(n.axis->point_at(prev ? meeting_point(n, *prev) : here));
-      add(n.axis->point_at(next ? meeting_point(n, *next) : here));
-    } else {
-      add(n.point);
-    }
-  }
-  return pts;
 }
 
 }  // namespace lampnav::graph

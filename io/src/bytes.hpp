@@ -19,7 +19,6 @@ class ByteWriter {
     u32(static_cast<std::uint32_t>(s.size()));
     buf_ += s;
   }
-  void bytes32(const std::string& s) { str(s); }
   void bytes64(const std::string& s) {
     u64(s.size());
     buf_ += s;

@@ -80,6 +80,13 @@ const char* record_name(std::uint8_t opcode) {
   }
 }
 
+// A record's opcode and content length, read from 9 bytes at `p` (the caller checks they exist).
+std::pair<std::uint8_t, std::uint64_t> record_header(const char* p) {
+  detail::ByteReader r(p, 9);
+  const std::uint8_t opcode = r.u8();
+  return {opcode, r.u64()};
+}
+
 class Parser {
  public:
   Parser(const std::string& bytes, std::string source) : b_(bytes), source_(std::move(source)) {}
@@ -96,10 +103,7 @@ class Parser {
         truncated(pos, "inside a record's opcode and length");
         break;
       }
-      const auto opcode = static_cast<std::uint8_t>(b_[pos]);
-      std::uint64_t len = 0;
-      for (int k = 0; k < 8; ++k)
-        len |= static_cast<std::uint64_t>(static_cast<std::uint8_t>(b_[pos + 1 + k])) << (8 * k);
+      const auto [opcode, len] = record_header(b_.data() + pos);
       const std::size_t body = pos + 9;
       if (len > b_.size() - body) {
         truncated(pos, std::string("inside a ") + record_name(opcode) + " record of " +
@@ -253,10 +257,7 @@ class Parser {
     std::size_t p = 0;
     while (p < records.size()) {
       if (records.size() - p < 9) break;
-      const auto opcode = static_cast<std::uint8_t>(records[p]);
-      std::uint64_t len = 0;
-      for (int k = 0; k < 8; ++k)
-        len |= static_cast<std::uint64_t>(static_cast<std::uint8_t>(records[p + 1 + k])) << (8 * k);
+      const auto [opcode, len] = record_header(records.data() + p);
       if (len > records.size() - p - 9) {
         problem(chunk_offset,
                 "a record inside the chunk runs past the chunk's end (rest of the chunk skipped)");

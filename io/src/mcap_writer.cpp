@@ -252,7 +252,7 @@ std::uint16_t McapWriter::add_schema(const std::string& name, const std::string&
   b.u16(id);
   b.str(name);
   b.str(encoding);
-  b.bytes32(data);
+  b.str(data);  // schema data: uint32 length + bytes, the same layout as a string
   std::string r = record(op::kSchema, b.data());
   impl_->emit(r);
   impl_->schema_records.push_back(std::move(r));

@@ -239,8 +239,8 @@ RecordStats record_mission(const Scenario& s, const std::string& path,
   }
   auto lamps_near = [&](const Pose2& p, double radius) {
     std::vector<const graph::Lamp*> out;
-    for (const graph::Lamp* l : working) {
-      if ((l->xyz.head<2>() - p.translation()).norm() <= radius) out.push_back(l);
+    for (const graph::Lamp* l : s.map.lamps_within(p.translation(), radius)) {
+      if (!s.failed_lamps.count(l->id.value)) out.push_back(l);
     }
     return out;
   };

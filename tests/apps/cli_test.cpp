@@ -129,12 +129,6 @@ TEST(Cli, RenderWritesPngAndSvg) {
   std::filesystem::remove_all(dir);
 }
 
-}  // namespace
-}  // namespace lampnav
-
-namespace lampnav {
-namespace {
-
 TEST(Cli, SimRecordsARouteAndRefusesBadInput) {
   const auto out = std::filesystem::temp_directory_path() /
                    ("lampnav_cli_sim_" + std::to_string(::getpid()) + ".mcap");

@@ -79,10 +79,6 @@ Vector3d PinholeCamera::unproject(const Vector2d& px) const {
   return Vector3d(xy.x(), xy.y(), 1.0).normalized();
 }
 
-bool PinholeCamera::in_image(const Vector2d& px) const {
-  return px.x() >= -0.5 && px.y() >= -0.5 && px.x() <= width_ - 0.5 && px.y() <= height_ - 0.5;
-}
-
 FisheyeCamera::FisheyeCamera(const CameraDescription& d)
     : p_(d.fisheye), width_(d.width), height_(d.height) {
   if (d.model != CameraModelKind::pajdla_bakstein) {
@@ -124,10 +120,6 @@ std::optional<Vector3d> FisheyeCamera::unproject(const Vector2d& px) const {
   const double phi = std::atan2(dy, dx);
   return Vector3d(std::sin(*theta) * std::cos(phi), std::sin(*theta) * std::sin(phi),
                   std::cos(*theta));
-}
-
-bool FisheyeCamera::in_image(const Vector2d& px) const {
-  return px.x() >= -0.5 && px.y() >= -0.5 && px.x() <= width_ - 0.5 && px.y() <= height_ - 0.5;
 }
 
 double ceiling_view_length(const CameraDescription& camera, double height) {

@@ -32,6 +32,12 @@ struct MapCheckOptions {
   std::optional<CeilingCoverage> coverage;  // the camera check runs only when given
 };
 
+// Lamps the ceiling camera could miss or confuse at the coverage's speed and frame rate: one
+// warning per corridor, at its limiting lamp.
+std::vector<MapWarning> check_camera_coverage(const TopologicalMap& map,
+                                              const CeilingCoverage& coverage,
+                                              const std::string& file = {});
+
 // Warnings: a node no edge reaches; nodes some other node cannot reach (the graph is not strongly
 // connected); a corridor without lamps; with `coverage`, lamps the camera could miss or confuse.
 std::vector<MapWarning> check_map(const TopologicalMap& map, const MapCheckOptions& options = {},

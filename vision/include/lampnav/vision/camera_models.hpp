@@ -9,6 +9,11 @@
 
 namespace lampnav::vision {
 
+// Whether a pixel lies in a width x height image (centres 0..W-1, with half a pixel of border).
+inline bool in_image(const Eigen::Vector2d& px, int width, int height) {
+  return px.x() >= -0.5 && px.y() >= -0.5 && px.x() <= width - 0.5 && px.y() <= height - 0.5;
+}
+
 // Pinhole with OpenCV's radial-tangential distortion [k1, k2, p1, p2, k3].
 class PinholeCamera {
  public:
@@ -28,7 +33,9 @@ class PinholeCamera {
   Eigen::Vector2d distort(const Eigen::Vector2d& xy) const;
   Eigen::Vector2d undistort(const Eigen::Vector2d& xy_distorted) const;
   // Whether a pixel lies in the image (pixel centres 0..W-1, 0..H-1, with half a pixel of border).
-  bool in_image(const Eigen::Vector2d& pixel) const;
+  bool in_image(const Eigen::Vector2d& pixel) const {
+    return vision::in_image(pixel, width_, height_);
+  }
 
  private:
   PinholeParameters p_;
@@ -54,7 +61,9 @@ class FisheyeCamera {
   std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& point) const;
   // Unit ray through a pixel; nullopt outside the field of view.
   std::optional<Eigen::Vector3d> unproject(const Eigen::Vector2d& pixel) const;
-  bool in_image(const Eigen::Vector2d& pixel) const;
+  bool in_image(const Eigen::Vector2d& pixel) const {
+    return vision::in_image(pixel, width_, height_);
+  }
 
  private:
   FisheyeParameters p_;
