@@ -13,6 +13,8 @@
 #include <sstream>
 #include <string>
 
+#include <Eigen/Core>
+
 #include "lampnav/core/pose2.hpp"
 
 namespace lampnav::test {
@@ -56,6 +58,21 @@ MATCHER_P3(IsNearPose, expected, pos_tol, yaw_tol,
   const double dyaw = std::fabs(wrap_angle(arg.yaw() - expected.yaw()));
   *result_listener << "position off by " << dp << " m, yaw by " << dyaw << " rad";
   return dp <= pos_tol && dyaw <= yaw_tol;
+}
+
+// Central-difference Jacobian of f: R^n -> R^m at x (GTSAM's habit: every analytic Jacobian is
+// checked against this).
+template <int M, int N, class F>
+Eigen::Matrix<double, M, N> numerical_jacobian(F f, const Eigen::Matrix<double, N, 1>& x,
+                                               double h = 1e-6) {
+  Eigen::Matrix<double, M, N> J;
+  for (int i = 0; i < N; ++i) {
+    Eigen::Matrix<double, N, 1> a = x, b = x;
+    a(i) += h;
+    b(i) -= h;
+    J.col(i) = (f(a) - f(b)) / (2 * h);
+  }
+  return J;
 }
 
 }  // namespace lampnav::test

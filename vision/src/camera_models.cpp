@@ -55,14 +55,41 @@ Vector2d PinholeCamera::undistort(const Vector2d& xd) const {
   for (int i = 0; i < 20; ++i) {
     const Vector2d e = distort(xy) - xd;
     if (e.squaredNorm() < 1e-24) break;
-    // Numerical Jacobian of distort at xy.
-    Eigen::Matrix2d J;
-    const double h = 1e-7;
-    J.col(0) = (distort(xy + Vector2d(h, 0)) - distort(xy - Vector2d(h, 0))) / (2 * h);
-    J.col(1) = (distort(xy + Vector2d(0, h)) - distort(xy - Vector2d(0, h))) / (2 * h);
-    xy -= J.lu().solve(e);
+    xy -= distort_jacobian(xy).lu().solve(e);
   }
   return xy;
+}
+
+Eigen::Matrix2d PinholeCamera::distort_jacobian(const Vector2d& xy) const {
+  const auto& k = p_.distortion;
+  const double x = xy.x(), y = xy.y();
+  const double r2 = x * x + y * y;
+  const double radial = 1 + k[0] * r2 + k[1] * r2 * r2 + k[4] * r2 * r2 * r2;
+  const double dradial = k[0] + 2 * k[1] * r2 + 3 * k[4] * r2 * r2;  // d radial / d r2
+  Eigen::Matrix2d J;
+  J(0, 0) = radial + x * dradial * 2 * x + 2 * k[2] * y + k[3] * 6 * x;
+  J(0, 1) = x * dradial * 2 * y + 2 * k[2] * x + k[3] * 2 * y;
+  J(1, 0) = y * dradial * 2 * x + k[2] * 2 * x + 2 * k[3] * y;
+  J(1, 1) = radial + y * dradial * 2 * y + k[2] * 6 * y + 2 * k[3] * x;
+  return J;
+}
+
+Vector2d PinholeCamera::normalized_of_pixel(const Vector2d& px) const {
+  return undistort(Vector2d((px.x() - p_.cx) / p_.fx, (px.y() - p_.cy) / p_.fy));
+}
+
+Vector2d PinholeCamera::pixel_of_normalized(const Vector2d& xy) const {
+  const Vector2d d = distort(xy);
+  return {p_.fx * d.x() + p_.cx, p_.fy * d.y() + p_.cy};
+}
+
+Eigen::Matrix<double, 2, 3> PinholeCamera::project_jacobian(const Vector3d& p) const {
+  const double iz = 1.0 / p.z();
+  const Vector2d xy(p.x() * iz, p.y() * iz);
+  Eigen::Matrix<double, 2, 3> dxy;  // d (x, y) / d (X, Y, Z)
+  dxy << iz, 0, -xy.x() * iz, 0, iz, -xy.y() * iz;
+  const Eigen::Matrix2d K = Eigen::Vector2d(p_.fx, p_.fy).asDiagonal();
+  return K * distort_jacobian(xy) * dxy;
 }
 
 std::optional<Vector2d> PinholeCamera::project(const Vector3d& p) const {
@@ -110,6 +137,26 @@ std::optional<Vector2d> FisheyeCamera::project(const Vector3d& p) const {
   const double phi = std::atan2(p.y(), p.x());
   const double r = radius(theta);
   return Vector2d(p_.u0 + r * std::cos(phi), p_.v0 + p_.beta * r * std::sin(phi));
+}
+
+Eigen::Matrix<double, 2, 3> FisheyeCamera::project_jacobian(const Vector3d& p) const {
+  // u = u0 + r(theta) cos(phi), v = v0 + beta r(theta) sin(phi); chain rule through theta, phi.
+  const double rho2 = p.x() * p.x() + p.y() * p.y();
+  const double rho = std::sqrt(rho2);
+  const double n2 = rho2 + p.z() * p.z();
+  const double theta = std::atan2(rho, p.z());
+  const double cphi = p.x() / rho, sphi = p.y() / rho;
+  const double sec = 1.0 / std::cos(theta / p_.b);
+  const double dr = p_.a / p_.b * sec * sec + p_.c / p_.d * std::cos(theta / p_.d);
+  const double r = radius(theta);
+  // d theta / d (X, Y, Z) and d phi / d (X, Y, Z).
+  const Eigen::RowVector3d dtheta(p.x() * p.z() / (rho * n2), p.y() * p.z() / (rho * n2),
+                                  -rho / n2);
+  const Eigen::RowVector3d dphi(-p.y() / rho2, p.x() / rho2, 0.0);
+  Eigen::Matrix<double, 2, 3> J;
+  J.row(0) = dr * cphi * dtheta - r * sphi * dphi;
+  J.row(1) = p_.beta * (dr * sphi * dtheta + r * cphi * dphi);
+  return J;
 }
 
 std::optional<Vector3d> FisheyeCamera::unproject(const Vector2d& px) const {

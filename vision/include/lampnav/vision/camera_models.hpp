@@ -32,6 +32,13 @@ class PinholeCamera {
   // Normalized image coordinates (x, y) = (X/Z, Y/Z) -> distorted ones, and back.
   Eigen::Vector2d distort(const Eigen::Vector2d& xy) const;
   Eigen::Vector2d undistort(const Eigen::Vector2d& xy_distorted) const;
+  // d distort / d (x, y), analytic.
+  Eigen::Matrix2d distort_jacobian(const Eigen::Vector2d& xy) const;
+  // Pixel -> undistorted normalized coordinates (x, y) = (X/Z, Y/Z), and back.
+  Eigen::Vector2d normalized_of_pixel(const Eigen::Vector2d& pixel) const;
+  Eigen::Vector2d pixel_of_normalized(const Eigen::Vector2d& xy) const;
+  // d pixel / d (X, Y, Z) of a camera-frame point in front of the lens (analytic).
+  Eigen::Matrix<double, 2, 3> project_jacobian(const Eigen::Vector3d& point) const;
   // Whether a pixel lies in the image (pixel centres 0..W-1, 0..H-1, with half a pixel of border).
   bool in_image(const Eigen::Vector2d& pixel) const {
     return vision::in_image(pixel, width_, height_);
@@ -59,6 +66,8 @@ class FisheyeCamera {
   std::optional<double> theta_of_radius(double r) const;
 
   std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& point) const;
+  // d pixel / d (X, Y, Z) of a camera-frame point off the optical axis (analytic).
+  Eigen::Matrix<double, 2, 3> project_jacobian(const Eigen::Vector3d& point) const;
   // Unit ray through a pixel; nullopt outside the field of view.
   std::optional<Eigen::Vector3d> unproject(const Eigen::Vector2d& pixel) const;
   bool in_image(const Eigen::Vector2d& pixel) const {
