@@ -1,0 +1,530 @@
+#include "lampnav/vision/lamp_detector.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <opencv2/imgproc.hpp>
+#include <string>
+
+#include "lampnav/vision/camera_models.hpp"
+
+namespace lampnav::vision {
+
+using Eigen::Vector2d;
+
+namespace {
+
+void require(bool ok, const char* what, const char* field, const std::string& message) {
+  if (!ok) throw InputError({"", what, field}, message);
+}
+
+// A horizontal run of above-threshold pixels; `parent` links runs of one component (union-find).
+struct Run {
+  int row, u0, u1;  // inclusive
+  int parent;
+};
+
+int find_root(std::vector<Run>& runs, int i) {
+  while (runs[i].parent != i) {
+    runs[i].parent = runs[runs[i].parent].parent;  // path halving
+    i = runs[i].parent;
+  }
+  return i;
+}
+
+struct Component {
+  int pixels = 0;
+  int u0 = 1 << 30, v0 = 1 << 30, u1 = -1, v1 = -1;
+  int first_run = 0, run_count = 0;  // into the runs sorted by component
+};
+
+struct Moments {
+  double m0 = 0, mx = 0, my = 0, mxx = 0, mxy = 0, myy = 0;
+  int pixels = 0;
+};
+
+// An edge point of the visible lamp in normalized coordinates.
+using EdgePoints = std::vector<Vector2d>;
+
+struct ShapeFit {
+  Vector2d centre = Vector2d::Zero();
+  double orientation = 0;
+  double rms = 0;  // normalized units
+  int points = 0;
+  bool ok = false;
+};
+
+// Gauss-Newton fit of a rectangle (half sizes a >= b) or a disc (radius a) of known size to edge
+// points (paper 2's completion "with a least square method"), from one initial guess. Points more
+// than three rms from the shape are dropped after the first iterations (fringe, corners).
+ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Vector2d c,
+                   double theta, double min_drop) {
+  ShapeFit fit;
+  std::vector<char> use(pts.size(), 1);
+  const int params = rectangle ? 3 : 2;
+  double rms = 0;
+  for (int it = 0; it < 20; ++it) {
+    Eigen::Matrix3d JtJ = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d Jtr = Eigen::Vector3d::Zero();
+    const double cs = std::cos(theta), sn = std::sin(theta);
+    double sum2 = 0;
+    int n = 0, ends = 0, sides = 0;
+    const double drop = std::max(min_drop, 3.0 * rms);
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const Vector2d d = pts[i] - c;
+      const Vector2d q(cs * d.x() + sn * d.y(), -sn * d.x() + cs * d.y());
+      double r;
+      Eigen::Vector3d J;
+      if (rectangle) {
+        const double rx = std::fabs(q.x()) - a, ry = std::fabs(q.y()) - b;
+        const bool end = std::fabs(rx) < std::fabs(ry);
+        const double s = end ? (q.x() >= 0 ? 1.0 : -1.0) : (q.y() >= 0 ? 1.0 : -1.0);
+        r = end ? rx : ry;
+        // q = R^T (p - c): dq/dc = -R^T, dq/dtheta = (q_y, -q_x).
+        if (end) {
+          J << -s * cs, -s * sn, s * q.y();
+        } else {
+          J << s * sn, -s * cs, -s * q.x();
+        }
+        if (it > 2 && std::fabs(r) > drop) use[i] = 0;
+        if (!use[i]) continue;
+        (end ? ends : sides) += 1;
+      } else {
+        const double dn = d.norm();
+        if (dn < 1e-12) continue;
+        r = dn - a;
+        J << -d.x() / dn, -d.y() / dn, 0.0;
+        if (it > 2 && std::fabs(r) > drop) use[i] = 0;
+        if (!use[i]) continue;
+      }
+      JtJ += J * J.transpose();
+      Jtr += J * r;
+      sum2 += r * r;
+      ++n;
+    }
+    if (n < 12) return fit;
+    rms = std::sqrt(sum2 / n);
+    fit.points = n;
+    fit.rms = rms;
+    // The fit must see an end and a long side of a rectangle, or its position along the lamp
+    // (or across it) is not determined.
+    if (rectangle && (ends < 4 || sides < 8)) return fit;
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    const auto block = JtJ.topLeftCorner(params, params);
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(block);
+    if (eig.eigenvalues()(0) < 1e-9 * std::max(1.0, eig.eigenvalues()(params - 1))) return fit;
+    step.head(params) = -block.ldlt().solve(Jtr.head(params));
+    c += step.head<2>();
+    theta += step(2);
+    if (step.head<2>().norm() < 1e-9 && std::fabs(step(2)) < 1e-9 && it > 3) break;
+  }
+  fit.centre = c;
+  fit.orientation = theta;
+  fit.ok = true;
+  return fit;
+}
+
+double wrap_half_pi(double a) {
+  a = std::remainder(a, M_PI);  // (-pi/2, pi/2]
+  return a <= -M_PI / 2 ? a + M_PI : a;
+}
+
+}  // namespace
+
+const char* to_string(LampView view) {
+  switch (view) {
+    case LampView::full:
+      return "full";
+    case LampView::completed:
+      return "completed";
+    case LampView::partial:
+      return "partial";
+  }
+  return "?";
+}
+
+void LampShapePrior::validate() const {
+  const char* what = "lamp shape";
+  require(length > 0 && std::isfinite(length), what, "length", "must be a positive length in m");
+  require(width > 0 && width <= length, what, "width", "must be positive and at most the length");
+  require(min_distance > 0 && std::isfinite(min_distance), what, "min_distance",
+          "must be positive (the lamps must be above the camera)");
+  require(max_distance >= min_distance && std::isfinite(max_distance), what, "max_distance",
+          "must be at least min_distance");
+  require(nominal_distance >= min_distance && nominal_distance <= max_distance, what,
+          "nominal_distance", "must lie between min_distance and max_distance");
+}
+
+void LampDetectorOptions::validate() const {
+  const char* what = "lamp detector options";
+  require(threshold >= 1 && threshold <= 255, what, "threshold", "must be 1 to 255");
+  require(min_area_fraction > 0 && min_area_fraction < 1, what, "min_area_fraction",
+          "must be between 0 and 1");
+  require(max_area_fraction > 1 && max_area_fraction < 10, what, "max_area_fraction",
+          "must be between 1 and 10");
+  require(complete_min_fraction >= min_area_fraction && complete_min_fraction <= 1, what,
+          "complete_min_fraction", "must be between min_area_fraction and 1");
+  require(opening_radius >= 0 && opening_radius <= 5, what, "opening_radius", "must be 0 to 5 px");
+  require(max_shape_error > 0 && max_shape_error < 1, what, "max_shape_error",
+          "must be between 0 and 1");
+  require(max_fit_rms_px > 0 && max_fit_rms_px <= 10, what, "max_fit_rms_px",
+          "must be between 0 and 10 px");
+}
+
+struct LampDetector::Impl {
+  PinholeCamera model;
+  LampShapePrior prior;
+  LampDetectorOptions o;
+  int w, h;
+  // Per pixel: undistorted normalized coordinates of its centre and the normalized area it covers.
+  std::vector<float> lut_x, lut_y, lut_w;
+  double area_nominal, area_min, area_max;  // of a whole lamp, normalized units^2
+  double min_pixels, max_pixels;            // pixel-count bounds that cannot drop a lamp
+  // Scratch, reused frame to frame.
+  std::vector<std::uint8_t> grey, binary;
+  std::vector<Run> runs;
+  std::vector<int> sorted_runs, component_of_root;
+  std::vector<Component> components;
+  cv::Mat mask, opened, kernel;
+  EdgePoints edges;
+
+  Impl(const CameraDescription& camera, const LampShapePrior& p, const LampDetectorOptions& opt)
+      : model(camera), prior(p), o(opt), w(camera.width), h(camera.height) {
+    prior.validate();
+    o.validate();
+    const std::size_t n = static_cast<std::size_t>(w) * h;
+    lut_x.resize(n);
+    lut_y.resize(n);
+    lut_w.resize(n);
+    const auto& k = model.parameters();
+    double w_min = 1e9, w_max = 0;
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        const std::size_t i = static_cast<std::size_t>(v) * w + u;
+        const Vector2d xy = model.normalized_of_pixel(Vector2d(u, v));
+        const double det = std::fabs(model.distort_jacobian(xy).determinant()) * k.fx * k.fy;
+        lut_x[i] = static_cast<float>(xy.x());
+        lut_y[i] = static_cast<float>(xy.y());
+        lut_w[i] = static_cast<float>(1.0 / det);
+        w_min = std::min(w_min, 1.0 / det);
+        w_max = std::max(w_max, 1.0 / det);
+      }
+    }
+    const double face = prior.rectangle ? prior.length * prior.width
+                                         : M_PI / 4 * prior.length * prior.length;
+    area_nominal = face / (prior.nominal_distance * prior.nominal_distance);
+    area_min = face / (prior.max_distance * prior.max_distance);
+    area_max = face / (prior.min_distance * prior.min_distance);
+    min_pixels = o.min_area_fraction * area_min / w_max * 0.8;
+    max_pixels = o.max_area_fraction * area_max / w_min * 1.25 + 64;
+    if (o.opening_radius > 0) {
+      kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * o.opening_radius + 1,
+                                                                  2 * o.opening_radius + 1));
+    }
+  }
+
+  std::size_t index(int u, int v) const { return static_cast<std::size_t>(v) * w + u; }
+
+  void label(const ImageView& g);
+  LampDetections detect(const ImageView& image);
+  bool measure(const Component& c, const ImageView& g, LampDetection& out, DetectionStats& st);
+  bool complete(const Component& c, const ImageView& g, int pad, LampDetection& out);
+};
+
+// Threshold (OpenCV, vectorized), then runs of lamp pixels per row joined into 8-connected
+// components by union-find: the ceiling is mostly dark, so the work follows the lamps' outlines.
+void LampDetector::Impl::label(const ImageView& g) {
+  binary.resize(static_cast<std::size_t>(w) * h);
+  const cv::Mat src(h, w, CV_8UC1, const_cast<std::uint8_t*>(g.data), g.row_stride());
+  cv::Mat dst(h, w, CV_8UC1, binary.data());
+  cv::threshold(src, dst, o.threshold - 1, 1, cv::THRESH_BINARY);
+  runs.clear();
+  int prev_begin = 0, prev_end = 0;
+  for (int v = 0; v < h; ++v) {
+    const std::uint8_t* b = binary.data() + index(0, v);
+    const int cur_begin = static_cast<int>(runs.size());
+    int u = 0;
+    while (u < w) {
+      while (u + 8 <= w) {  // skip dark ceiling eight pixels at a time
+        std::uint64_t word;
+        std::memcpy(&word, b + u, 8);
+        if (word != 0) break;
+        u += 8;
+      }
+      while (u < w && b[u] == 0) ++u;
+      if (u >= w) break;
+      const int start = u;
+      while (u < w && b[u] != 0) ++u;
+      const int id = static_cast<int>(runs.size());
+      runs.push_back({v, start, u - 1, id});
+    }
+    const int cur_end = static_cast<int>(runs.size());
+    int j0 = prev_begin;
+    for (int c = cur_begin; c < cur_end; ++c) {
+      while (j0 < prev_end && runs[j0].u1 < runs[c].u0 - 1) ++j0;
+      for (int j = j0; j < prev_end && runs[j].u0 <= runs[c].u1 + 1; ++j) {
+        const int ra = find_root(runs, j), rb = find_root(runs, c);
+        if (ra != rb) runs[std::max(ra, rb)].parent = std::min(ra, rb);
+      }
+    }
+    prev_begin = cur_begin;
+    prev_end = cur_end;
+  }
+  // Components, and their runs grouped together (counting sort by component).
+  components.clear();
+  component_of_root.assign(runs.size(), -1);
+  std::vector<int>& comp_of_run = sorted_runs;
+  comp_of_run.resize(runs.size());
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    const int r = find_root(runs, static_cast<int>(i));
+    if (component_of_root[r] < 0) {
+      component_of_root[r] = static_cast<int>(components.size());
+      components.emplace_back();
+    }
+    Component& c = components[component_of_root[r]];
+    const Run& run = runs[i];
+    c.pixels += run.u1 - run.u0 + 1;
+    c.u0 = std::min(c.u0, run.u0);
+    c.u1 = std::max(c.u1, run.u1);
+    c.v0 = std::min(c.v0, run.row);
+    c.v1 = std::max(c.v1, run.row);
+    ++c.run_count;
+    comp_of_run[i] = component_of_root[r];
+  }
+  int offset = 0;
+  for (auto& c : components) {
+    c.first_run = offset;
+    offset += c.run_count;
+    c.run_count = 0;
+  }
+  std::vector<int> order(runs.size());
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    Component& c = components[comp_of_run[i]];
+    order[c.first_run + c.run_count++] = static_cast<int>(i);
+  }
+  sorted_runs = std::move(order);
+}
+
+LampDetections LampDetector::Impl::detect(const ImageView& image) {
+  check_image(image, w, h, {"", "image", ""});
+  const ImageView g = grey_view(image, grey);
+  label(g);
+  LampDetections out;
+  out.stats.blobs = static_cast<int>(components.size());
+  for (const Component& c : components) {
+    if (c.pixels < min_pixels) {
+      ++out.stats.too_small;
+      continue;
+    }
+    if (c.pixels > max_pixels) {
+      ++out.stats.too_large;
+      continue;
+    }
+    LampDetection d;
+    if (measure(c, g, d, out.stats)) out.lamps.push_back(d);
+  }
+  return out;
+}
+
+bool LampDetector::Impl::measure(const Component& c, const ImageView& g, LampDetection& out,
+                                 DetectionStats& st) {
+  // The component's mask with a margin; on sides where the lamp leaves the image the mask is
+  // continued outwards so that the opening does not eat the cut edge.
+  const int r = o.opening_radius, pad = 2 * r + 1;
+  const int mw = c.u1 - c.u0 + 1 + 2 * pad, mh = c.v1 - c.v0 + 1 + 2 * pad;
+  mask.create(mh, mw, CV_8UC1);
+  mask.setTo(0);
+  for (int k = 0; k < c.run_count; ++k) {
+    const Run& run = runs[sorted_runs[c.first_run + k]];
+    std::memset(mask.ptr(run.row - c.v0 + pad) + (run.u0 - c.u0 + pad), 1,
+                static_cast<std::size_t>(run.u1 - run.u0 + 1));
+  }
+  const bool cut_left = c.u0 == 0, cut_right = c.u1 == w - 1;
+  const bool cut_top = c.v0 == 0, cut_bottom = c.v1 == h - 1;
+  if (r > 0) {
+    for (int y = pad; y < mh - pad; ++y) {
+      std::uint8_t* row = mask.ptr(y);
+      if (cut_left) std::memset(row, row[pad], static_cast<std::size_t>(pad));
+      if (cut_right) std::memset(row + mw - pad, row[mw - pad - 1], static_cast<std::size_t>(pad));
+    }
+    for (int y = 0; y < pad; ++y) {
+      if (cut_top) mask.row(pad).copyTo(mask.row(y));
+      if (cut_bottom) mask.row(mh - pad - 1).copyTo(mask.row(mh - 1 - y));
+    }
+    cv::morphologyEx(mask, opened, cv::MORPH_OPEN, kernel);
+  } else {
+    opened = mask;
+  }
+  // Moments in undistorted normalized coordinates, each pixel weighted by the area it covers.
+  Moments m;
+  const int mid_u = (c.u0 + c.u1) / 2, mid_v = (c.v0 + c.v1) / 2;
+  int seed_d = 1 << 30;
+  bool touches_border = false;  // after the opening: a fringe pixel at the border is no cut
+  for (int v = c.v0; v <= c.v1; ++v) {
+    const std::uint8_t* row = opened.ptr(v - c.v0 + pad) + pad - c.u0;
+    const std::size_t base = index(0, v);
+    for (int u = c.u0; u <= c.u1; ++u) {
+      if (!row[u]) continue;
+      const std::size_t i = base + u;
+      const double wt = lut_w[i], x = lut_x[i], y = lut_y[i];
+      m.m0 += wt;
+      m.mx += wt * x;
+      m.my += wt * y;
+      // A pixel is a small square, not a point: its own spread adds wt^2 / 12 to each axis.
+      m.mxx += wt * (x * x + wt / 12);
+      m.mxy += wt * x * y;
+      m.myy += wt * (y * y + wt / 12);
+      ++m.pixels;
+      touches_border |= u == 0 || v == 0 || u == w - 1 || v == h - 1;
+      const int d = std::abs(u - mid_u) + std::abs(v - mid_v);
+      if (d < seed_d) {
+        seed_d = d;
+        out.seed = {u, v};
+      }
+    }
+  }
+  if (m.pixels == 0 || m.m0 <= 0) {
+    ++st.too_small;
+    return false;
+  }
+  const double cx = m.mx / m.m0, cy = m.my / m.m0;
+  const double mu20 = m.mxx / m.m0 - cx * cx, mu02 = m.myy / m.m0 - cy * cy;
+  const double mu11 = m.mxy / m.m0 - cx * cy;
+  const double half_sum = 0.5 * (mu20 + mu02);
+  const double root = std::sqrt(0.25 * (mu20 - mu02) * (mu20 - mu02) + mu11 * mu11);
+  const double l1 = half_sum + root, l2 = std::max(0.0, half_sum - root);
+  out.centre = Vector2d(cx, cy);
+  out.orientation = wrap_half_pi(0.5 * std::atan2(2 * mu11, mu20 - mu02));
+  // Uniform rectangle: variance L^2 / 12 along a side; uniform disc: D^2 / 16 on any axis.
+  const double k = prior.rectangle ? 12.0 : 16.0;
+  out.length = std::sqrt(k * l1);
+  out.width = std::sqrt(k * l2);
+  out.area = m.m0;
+  out.pixels = m.pixels;
+  out.bbox = {c.u0, c.v0, c.u1, c.v1};
+  out.visible_fraction = m.m0 / area_nominal;
+  if (m.m0 < o.min_area_fraction * area_min) {
+    ++st.too_small;
+    return false;
+  }
+  if (m.m0 > o.max_area_fraction * area_max) {
+    ++st.too_large;
+    return false;
+  }
+  if (!touches_border) {
+    // The axes of a whole lamp must match the prior at some distance in the range.
+    const double e = o.max_shape_error;
+    const double len_lo = prior.length / prior.max_distance * (1 - e);
+    const double len_hi = prior.length / prior.min_distance * (1 + e);
+    const double wid_lo = prior.width / prior.max_distance * (1 - e);
+    const double wid_hi = prior.width / prior.min_distance * (1 + e);
+    if (out.length < len_lo || out.length > len_hi || out.width < wid_lo || out.width > wid_hi) {
+      ++st.wrong_shape;
+      return false;
+    }
+    out.view = LampView::full;
+    out.visible_fraction = std::min(out.visible_fraction, 1.0);
+  } else {
+    out.view = LampView::partial;
+    if (out.visible_fraction >= o.complete_min_fraction) {
+      if (complete(c, g, pad, out)) {
+        out.view = LampView::completed;
+      } else {
+        ++st.completion_failed;
+      }
+    }
+  }
+  out.centre_px = model.pixel_of_normalized(out.centre);
+  return true;
+}
+
+// Completion of a lamp cut by the image border (paper 2, Fig. 5): the visible edges, located to a
+// fraction of a pixel where the grey level crosses the threshold, are fitted with the known shape.
+bool LampDetector::Impl::complete(const Component& c, const ImageView& g, int pad,
+                                  LampDetection& out) {
+  edges.clear();
+  const double level = o.threshold - 0.5;
+  auto inside = [&](int u, int v) {
+    if (u < c.u0 || u > c.u1 || v < c.v0 || v > c.v1) return false;
+    return opened.at<std::uint8_t>(v - c.v0 + pad, u - c.u0 + pad) != 0;
+  };
+  auto grey_at = [&](int u, int v) {
+    return static_cast<double>(g.data[static_cast<std::size_t>(v) * g.row_stride() + u]);
+  };
+  // Border pixels of the cut tell on which side of the visible part the rest of the lamp lies.
+  Vector2d border_sum = Vector2d::Zero();
+  int border_n = 0;
+  static const int du[4] = {1, -1, 0, 0}, dv[4] = {0, 0, 1, -1};
+  for (int v = c.v0; v <= c.v1; ++v) {
+    for (int u = c.u0; u <= c.u1; ++u) {
+      if (!inside(u, v)) continue;
+      if (u == 0 || v == 0 || u == w - 1 || v == h - 1) {
+        const std::size_t i = index(u, v);
+        border_sum += Vector2d(lut_x[i], lut_y[i]);
+        ++border_n;
+      }
+      for (int k = 0; k < 4; ++k) {
+        const int un = u + du[k], vn = v + dv[k];
+        if (un < 0 || vn < 0 || un >= w || vn >= h || inside(un, vn)) continue;
+        const double gi = grey_at(u, v), go = grey_at(un, vn);
+        const double t = gi > go ? std::clamp((gi - level) / (gi - go), 0.0, 1.0) : 0.5;
+        const std::size_t a = index(u, v), b = index(un, vn);
+        edges.emplace_back(lut_x[a] + t * (lut_x[b] - lut_x[a]), lut_y[a] + t * (lut_y[b] - lut_y[a]));
+      }
+    }
+  }
+  if (edges.size() < 16 || border_n == 0) return false;
+  const double half_a = prior.length / (2 * prior.nominal_distance);
+  const double half_b = (prior.rectangle ? prior.width : prior.length) / (2 * prior.nominal_distance);
+  const double px = 1.0 / model.parameters().fx;  // one pixel in normalized units (about)
+  // Initial guesses: the visible centroid moved towards the cut, along and across the lamp, so
+  // that the uncut end (or side) stays where it is seen.
+  const Vector2d centroid = out.centre;
+  const Vector2d to_cut = border_sum / border_n - centroid;
+  const Vector2d e(std::cos(out.orientation), std::sin(out.orientation));
+  const Vector2d n(-e.y(), e.x());
+  double s_lo = 1e9, s_hi = -1e9, t_lo = 1e9, t_hi = -1e9;
+  for (const auto& p : edges) {
+    const Vector2d d = p - centroid;
+    s_lo = std::min(s_lo, d.dot(e));
+    s_hi = std::max(s_hi, d.dot(e));
+    t_lo = std::min(t_lo, d.dot(n));
+    t_hi = std::max(t_hi, d.dot(n));
+  }
+  const double along = to_cut.dot(e) >= 0 ? 1.0 : -1.0;
+  const double across = to_cut.dot(n) >= 0 ? 1.0 : -1.0;
+  const Vector2d from_end = centroid + e * ((along > 0 ? s_lo : s_hi) + along * half_a);
+  const Vector2d from_side = centroid + n * ((across > 0 ? t_lo : t_hi) + across * half_b);
+  const Vector2d from_both = from_end + n * ((across > 0 ? t_lo : t_hi) + across * half_b);
+  ShapeFit best;
+  for (const Vector2d& start : {from_end, from_side, from_both, centroid}) {
+    const ShapeFit f =
+        fit_shape(edges, prior.rectangle, half_a, half_b, start, out.orientation, 2 * px);
+    if (f.ok && (!best.ok || f.rms < best.rms)) best = f;
+  }
+  if (!best.ok || best.rms / px > o.max_fit_rms_px) return false;
+  out.centre = best.centre;
+  if (prior.rectangle) out.orientation = wrap_half_pi(best.orientation);
+  out.length = 2 * half_a;
+  out.width = 2 * half_b;
+  out.fit_points = best.points;
+  out.fit_rms_px = best.rms / px;
+  return true;
+}
+
+LampDetector::LampDetector(const CameraDescription& camera, const LampShapePrior& prior,
+                           const LampDetectorOptions& options)
+    : impl_(std::make_unique<Impl>(camera, prior, options)) {}
+LampDetector::~LampDetector() = default;
+LampDetector::LampDetector(LampDetector&&) noexcept = default;
+LampDetector& LampDetector::operator=(LampDetector&&) noexcept = default;
+
+LampDetections LampDetector::detect(const ImageView& image) { return impl_->detect(image); }
+double LampDetector::expected_area() const { return impl_->area_nominal; }
+const LampShapePrior& LampDetector::prior() const { return impl_->prior; }
+const LampDetectorOptions& LampDetector::options() const { return impl_->o; }
+int LampDetector::width() const { return impl_->w; }
+int LampDetector::height() const { return impl_->h; }
+
+}  // namespace lampnav::vision
