@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <opencv2/imgproc.hpp>
 #include <string>
 
 #include "lampnav/vision/camera_models.hpp"
@@ -117,12 +116,58 @@ ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Ve
     step.head(params) = -block.ldlt().solve(Jtr.head(params));
     c += step.head<2>();
     theta += step(2);
-    if (step.head<2>().norm() < 1e-9 && std::fabs(step(2)) < 1e-9 && it > 3) break;
+    if (step.head<2>().norm() < 1e-6 && std::fabs(step(2)) < 1e-5 && it > 3) break;
   }
   fit.centre = c;
   fit.orientation = theta;
   fit.ok = true;
   return fit;
+}
+
+// Morphological opening (erosion, then dilation) of a 0/1 mask by a (2r+1)^2 square, done as
+// separable running minima and maxima over rows, then columns. Pixels within r of the mask's own
+// edge are treated as outside; the caller pads the mask by more than r.
+void open_mask(const std::vector<std::uint8_t>& in, int w, int h, int r,
+               std::vector<std::uint8_t>& out, std::vector<std::uint8_t>& tmp) {
+  out.assign(in.size(), 0);
+  tmp.assign(in.size(), 0);
+  // Along rows: dst[k] = AND (or OR) of src[k - r .. k + r], for k with the whole window inside.
+  auto rows = [&](const std::uint8_t* src, std::uint8_t* dst, bool erode) {
+    for (int y = 0; y < h; ++y) {
+      const std::uint8_t* a = src + static_cast<std::size_t>(y) * w;
+      std::uint8_t* d = dst + static_cast<std::size_t>(y) * w;
+      std::memset(d, 0, static_cast<std::size_t>(w));
+      std::memcpy(d + r, a, static_cast<std::size_t>(w - 2 * r));  // window start a[k - r]
+      for (int j = -r + 1; j <= r; ++j) {
+        const std::uint8_t* b = a + r + j;
+        if (erode) {
+          for (int k = r; k < w - r; ++k) d[k] &= b[k - r];
+        } else {
+          for (int k = r; k < w - r; ++k) d[k] |= b[k - r];
+        }
+      }
+    }
+  };
+  // Along columns, whole rows at a time (vectorizable).
+  auto cols = [&](const std::uint8_t* src, std::uint8_t* dst, bool erode) {
+    std::memset(dst, 0, static_cast<std::size_t>(w) * h);
+    for (int y = r; y < h - r; ++y) {
+      std::uint8_t* d = dst + static_cast<std::size_t>(y) * w;
+      std::memcpy(d, src + static_cast<std::size_t>(y - r) * w, static_cast<std::size_t>(w));
+      for (int j = -r + 1; j <= r; ++j) {
+        const std::uint8_t* a = src + static_cast<std::size_t>(y + j) * w;
+        if (erode) {
+          for (int k = 0; k < w; ++k) d[k] &= a[k];
+        } else {
+          for (int k = 0; k < w; ++k) d[k] |= a[k];
+        }
+      }
+    }
+  };
+  rows(in.data(), tmp.data(), true);
+  cols(tmp.data(), out.data(), true);  // eroded
+  rows(out.data(), tmp.data(), false);
+  cols(tmp.data(), out.data(), false);  // opened
 }
 
 double wrap_half_pi(double a) {
@@ -186,7 +231,8 @@ struct LampDetector::Impl {
   std::vector<Run> runs;
   std::vector<int> sorted_runs, component_of_root;
   std::vector<Component> components;
-  cv::Mat mask, opened, kernel;
+  std::vector<std::uint8_t> mask, opened, scratch;
+  int mask_width = 0;
   EdgePoints edges;
 
   Impl(const CameraDescription& camera, const LampShapePrior& p, const LampDetectorOptions& opt)
@@ -218,10 +264,6 @@ struct LampDetector::Impl {
     area_max = face / (prior.min_distance * prior.min_distance);
     min_pixels = o.min_area_fraction * area_min / w_max * 0.8;
     max_pixels = o.max_area_fraction * area_max / w_min * 1.25 + 64;
-    if (o.opening_radius > 0) {
-      kernel = cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * o.opening_radius + 1,
-                                                                  2 * o.opening_radius + 1));
-    }
   }
 
   std::size_t index(int u, int v) const { return static_cast<std::size_t>(v) * w + u; }
@@ -236,9 +278,13 @@ struct LampDetector::Impl {
 // components by union-find: the ceiling is mostly dark, so the work follows the lamps' outlines.
 void LampDetector::Impl::label(const ImageView& g) {
   binary.resize(static_cast<std::size_t>(w) * h);
-  const cv::Mat src(h, w, CV_8UC1, const_cast<std::uint8_t*>(g.data), g.row_stride());
-  cv::Mat dst(h, w, CV_8UC1, binary.data());
-  cv::threshold(src, dst, o.threshold - 1, 1, cv::THRESH_BINARY);
+  const std::uint8_t t = static_cast<std::uint8_t>(o.threshold);
+  const int width = w;
+  for (int v = 0; v < h; ++v) {  // a plain loop the compiler vectorizes; no thread pool
+    const std::uint8_t* __restrict in = g.data + static_cast<std::size_t>(v) * g.row_stride();
+    std::uint8_t* __restrict out = binary.data() + index(0, v);
+    for (int u = 0; u < width; ++u) out[u] = in[u] >= t ? 1 : 0;
+  }
   runs.clear();
   int prev_begin = 0, prev_end = 0;
   for (int v = 0; v < h; ++v) {
@@ -333,26 +379,28 @@ bool LampDetector::Impl::measure(const Component& c, const ImageView& g, LampDet
   // continued outwards so that the opening does not eat the cut edge.
   const int r = o.opening_radius, pad = 2 * r + 1;
   const int mw = c.u1 - c.u0 + 1 + 2 * pad, mh = c.v1 - c.v0 + 1 + 2 * pad;
-  mask.create(mh, mw, CV_8UC1);
-  mask.setTo(0);
+  mask_width = mw;
+  mask.assign(static_cast<std::size_t>(mw) * mh, 0);
+  auto mrow = [&](std::vector<std::uint8_t>& m, int y) { return m.data() + static_cast<std::size_t>(y) * mw; };
   for (int k = 0; k < c.run_count; ++k) {
     const Run& run = runs[sorted_runs[c.first_run + k]];
-    std::memset(mask.ptr(run.row - c.v0 + pad) + (run.u0 - c.u0 + pad), 1,
+    std::memset(mrow(mask, run.row - c.v0 + pad) + (run.u0 - c.u0 + pad), 1,
                 static_cast<std::size_t>(run.u1 - run.u0 + 1));
   }
   const bool cut_left = c.u0 == 0, cut_right = c.u1 == w - 1;
   const bool cut_top = c.v0 == 0, cut_bottom = c.v1 == h - 1;
   if (r > 0) {
     for (int y = pad; y < mh - pad; ++y) {
-      std::uint8_t* row = mask.ptr(y);
+      std::uint8_t* row = mrow(mask, y);
       if (cut_left) std::memset(row, row[pad], static_cast<std::size_t>(pad));
       if (cut_right) std::memset(row + mw - pad, row[mw - pad - 1], static_cast<std::size_t>(pad));
     }
     for (int y = 0; y < pad; ++y) {
-      if (cut_top) mask.row(pad).copyTo(mask.row(y));
-      if (cut_bottom) mask.row(mh - pad - 1).copyTo(mask.row(mh - 1 - y));
+      if (cut_top) std::memcpy(mrow(mask, y), mrow(mask, pad), static_cast<std::size_t>(mw));
+      if (cut_bottom)
+        std::memcpy(mrow(mask, mh - 1 - y), mrow(mask, mh - pad - 1), static_cast<std::size_t>(mw));
     }
-    cv::morphologyEx(mask, opened, cv::MORPH_OPEN, kernel);
+    open_mask(mask, mw, mh, r, opened, scratch);
   } else {
     opened = mask;
   }
@@ -362,7 +410,7 @@ bool LampDetector::Impl::measure(const Component& c, const ImageView& g, LampDet
   int seed_d = 1 << 30;
   bool touches_border = false;  // after the opening: a fringe pixel at the border is no cut
   for (int v = c.v0; v <= c.v1; ++v) {
-    const std::uint8_t* row = opened.ptr(v - c.v0 + pad) + pad - c.u0;
+    const std::uint8_t* row = opened.data() + static_cast<std::size_t>(v - c.v0 + pad) * mw + pad - c.u0;
     const std::size_t base = index(0, v);
     for (int u = c.u0; u <= c.u1; ++u) {
       if (!row[u]) continue;
@@ -447,7 +495,7 @@ bool LampDetector::Impl::complete(const Component& c, const ImageView& g, int pa
   const double level = o.threshold - 0.5;
   auto inside = [&](int u, int v) {
     if (u < c.u0 || u > c.u1 || v < c.v0 || v > c.v1) return false;
-    return opened.at<std::uint8_t>(v - c.v0 + pad, u - c.u0 + pad) != 0;
+    return opened[static_cast<std::size_t>(v - c.v0 + pad) * mask_width + (u - c.u0 + pad)] != 0;
   };
   auto grey_at = [&](int u, int v) {
     return static_cast<double>(g.data[static_cast<std::size_t>(v) * g.row_stride() + u]);
@@ -502,6 +550,7 @@ bool LampDetector::Impl::complete(const Component& c, const ImageView& g, int pa
     const ShapeFit f =
         fit_shape(edges, prior.rectangle, half_a, half_b, start, out.orientation, 2 * px);
     if (f.ok && (!best.ok || f.rms < best.rms)) best = f;
+    if (best.ok && best.rms < 0.5 * px) break;  // edges fit to noise level: no other start needed
   }
   if (!best.ok || best.rms / px > o.max_fit_rms_px) return false;
   out.centre = best.centre;

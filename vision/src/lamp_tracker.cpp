@@ -37,7 +37,7 @@ struct LampTracker::Impl {
   std::vector<Track> tracks;
   std::vector<int> pending_ended;  // from reset()
   int next_id = 1;
-  std::vector<std::uint8_t> grey;
+  std::vector<std::uint8_t> grey, half;
 
   Impl(const CameraDescription& camera, const LampShapePrior& prior,
        const LampDetectorOptions& detector_options, const LampTrackerOptions& options)
@@ -67,10 +67,24 @@ TrackedFrame LampTracker::Impl::process(const ImageView& image) {
   pending_ended.clear();
   LampDetections found = detector.detect(g);
   out.stats = found.stats;
-  // vpImage over the frame's own bytes: no copy (ViSP only reads it here).
-  const vpImage<unsigned char> I(const_cast<unsigned char*>(g.data),
-                                 static_cast<unsigned>(g.height), static_cast<unsigned>(g.width),
+  // vpDot2 follows each blob's outline; at half resolution the outline, and vpDot2's per-frame
+  // copy of it, is half as long. Identity needs no more: the detector measures at full resolution.
+  const int hw = g.width / 2, hh = g.height / 2;
+  half.resize(static_cast<std::size_t>(hw) * hh);
+  for (int v = 0; v < hh; ++v) {
+    const std::uint8_t* __restrict a = g.data + static_cast<std::size_t>(2 * v) * g.row_stride();
+    const std::uint8_t* __restrict b = a + g.row_stride();
+    std::uint8_t* __restrict dst = half.data() + static_cast<std::size_t>(v) * hw;
+    for (int u = 0; u < hw; ++u) {
+      dst[u] = static_cast<std::uint8_t>((a[2 * u] + a[2 * u + 1] + b[2 * u] + b[2 * u + 1] + 2) >> 2);
+    }
+  }
+  const vpImage<unsigned char> I(half.data(), static_cast<unsigned>(hh), static_cast<unsigned>(hw),
                                  false);
+  // Half-resolution pixel centre (i, j) covers full-resolution pixels 2i, 2i + 1.
+  auto to_full = [](const vpImagePoint& p) {
+    return Eigen::Vector2d(2 * p.get_u() + 0.5, 2 * p.get_v() + 0.5);
+  };
   std::vector<int> owner(found.lamps.size(), -1);  // detection -> track index
   std::vector<Track> kept;
   kept.reserve(tracks.size());
@@ -88,15 +102,15 @@ TrackedFrame LampTracker::Impl::process(const ImageView& image) {
     }
     int match = -1;
     if (alive) {
-      const vpImagePoint cog = t.dot.getCog();
-      if (vpImagePoint::distance(cog, before) > o.max_step_px) {
+      const Eigen::Vector2d cog = to_full(t.dot.getCog());
+      if ((cog - to_full(before)).norm() > o.max_step_px) {
         alive = false;
       } else {
         double best = 1e18;
         for (std::size_t k = 0; k < found.lamps.size(); ++k) {
           const auto& d = found.lamps[k];
-          if (!contains(d.bbox, cog.get_u(), cog.get_v())) continue;
-          const double dist = (d.centre_px - Eigen::Vector2d(cog.get_u(), cog.get_v())).norm();
+          if (!contains(d.bbox, cog.x(), cog.y())) continue;
+          const double dist = (d.centre_px - cog).norm();
           if (dist < best) {
             best = dist;
             match = static_cast<int>(k);
@@ -125,7 +139,7 @@ TrackedFrame LampTracker::Impl::process(const ImageView& image) {
     configure(t.dot);
     const auto& seed = found.lamps[k].seed;
     try {
-      t.dot.initTracking(I, vpImagePoint(seed[1], seed[0]), threshold, 255);
+      t.dot.initTracking(I, vpImagePoint(seed[1] / 2, seed[0] / 2), threshold, 255);
     } catch (const vpException&) {
       continue;  // the blob is not trackable (vpDot2 refused it); it is detected again next frame
     }

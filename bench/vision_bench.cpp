@@ -1,0 +1,126 @@
+// Ceiling-frame lamp detection and tracking on 352x288 frames of a simulated corridor drive, side
+// by side with OpenCV's SimpleBlobDetector and ViSP's vpDot2::searchDotsInArea on the same frames.
+// Target (issue 4): detection plus tracking at most 200 us per frame on one core.
+
+#include <benchmark/benchmark.h>
+
+#include <opencv2/features2d.hpp>
+#include <random>
+#include <visp3/blob/vpDot2.h>
+#include <visp3/core/vpImage.h>
+
+#include "lampnav/graph/geojson.hpp"
+#include "lampnav/sim/renderers.hpp"
+#include "lampnav/vision/lamp_tracker.hpp"
+
+namespace {
+
+using namespace lampnav;
+
+struct Frames {
+  RobotDescription robot;
+  std::vector<Image8> images;
+  Frames() {
+    const std::string src = LAMPNAV_SOURCE_DIR;
+    robot = read_robot_description(src + "/maps/robots/pioneer.json");
+    const auto map = graph::read_map(src + "/maps/office_floor.geojson").map;
+    const sim::CeilingRenderer renderer(*robot.find_camera("ceiling_camera"), {});
+    const graph::Node& c1 = *map.find_node("C1");
+    const Eigen::Vector2d dir = c1.axis->direction();
+    std::mt19937_64 rng(1);
+    // 0.5 m/s at 10 Hz along C1, the default floor bumps.
+    std::normal_distribution<double> bump(0, 0.5 * M_PI / 180);
+    for (double s = 0.5; s < c1.axis->length() - 0.5; s += 0.05) {
+      const Pose2 pose(c1.axis->point_at(s), std::atan2(dir.y(), dir.x()));
+      images.push_back(renderer.render(pose, {bump(rng), bump(rng)},
+                                       map.lamps_within(pose.translation(), 5.0), rng));
+    }
+  }
+  const CameraDescription& camera() const { return *robot.find_camera("ceiling_camera"); }
+};
+
+const Frames& frames() {
+  static const Frames f;
+  return f;
+}
+
+void BM_LampDetector(benchmark::State& state) {
+  const Frames& f = frames();
+  vision::LampDetector detector(f.camera(), vision::LampShapePrior{});
+  std::size_t i = 0, lamps = 0;
+  for (auto _ : state) {
+    const auto d = detector.detect(f.images[i++ % f.images.size()]);
+    lamps += d.lamps.size();
+    benchmark::DoNotOptimize(d);
+  }
+  state.counters["lamps_per_frame"] = static_cast<double>(lamps) / state.iterations();
+}
+BENCHMARK(BM_LampDetector)->Unit(benchmark::kMicrosecond);
+
+// Detection plus vpDot2 tracking, frames in driving order.
+void BM_LampDetectAndTrack(benchmark::State& state) {
+  const Frames& f = frames();
+  vision::LampTracker tracker(f.camera(), vision::LampShapePrior{});
+  std::size_t i = 0;
+  for (auto _ : state) {
+    if (i % f.images.size() == 0) tracker.reset();  // the drive starts again
+    const auto t = tracker.process(f.images[i++ % f.images.size()]);
+    benchmark::DoNotOptimize(t);
+  }
+}
+BENCHMARK(BM_LampDetectAndTrack)->Unit(benchmark::kMicrosecond);
+
+void BM_OpenCvSimpleBlobDetector(benchmark::State& state) {
+  const Frames& f = frames();
+  cv::SimpleBlobDetector::Params p;
+  p.filterByColor = true;
+  p.blobColor = 255;
+  p.minThreshold = 128;
+  p.maxThreshold = 129;  // one threshold, as ours
+  p.thresholdStep = 10;
+  p.minRepeatability = 1;
+  p.filterByArea = true;
+  p.minArea = 2500;
+  p.maxArea = 12000;
+  p.filterByCircularity = false;
+  p.filterByConvexity = false;
+  p.filterByInertia = false;
+  const auto detector = cv::SimpleBlobDetector::create(p);
+  std::size_t i = 0, found = 0;
+  std::vector<cv::KeyPoint> keypoints;
+  for (auto _ : state) {
+    const Image8& img = f.images[i++ % f.images.size()];
+    const cv::Mat m(img.height, img.width, CV_8UC1, const_cast<std::uint8_t*>(img.pixels.data()));
+    detector->detect(m, keypoints);
+    found += keypoints.size();
+  }
+  state.counters["lamps_per_frame"] = static_cast<double>(found) / state.iterations();
+}
+BENCHMARK(BM_OpenCvSimpleBlobDetector)->Unit(benchmark::kMicrosecond);
+
+void BM_VispSearchDotsInArea(benchmark::State& state) {
+  const Frames& f = frames();
+  vpDot2 model;
+  model.setGraphics(false);
+  model.setGrayLevelMin(128);
+  model.setGrayLevelMax(255);
+  model.setEllipsoidShapePrecision(0);
+  model.setSizePrecision(0.5);
+  model.setWidth(150);
+  model.setHeight(38);
+  model.setArea(5700);
+  std::size_t i = 0, found = 0;
+  for (auto _ : state) {
+    Image8& img = const_cast<Image8&>(f.images[i++ % f.images.size()]);
+    const vpImage<unsigned char> I(img.pixels.data(), static_cast<unsigned>(img.height),
+                                   static_cast<unsigned>(img.width), false);
+    std::list<vpDot2> dots;
+    model.searchDotsInArea(I, 0, 0, I.getWidth(), I.getHeight(), dots);
+    found += dots.size();
+  }
+  state.counters["lamps_per_frame"] = static_cast<double>(found) / state.iterations();
+}
+BENCHMARK(BM_VispSearchDotsInArea)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
+BENCHMARK_MAIN();
