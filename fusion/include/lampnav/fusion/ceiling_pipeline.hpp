@@ -1,0 +1,111 @@
+#pragma once
+// From a ceiling-camera frame to labelled lamps and a pose measurement (paper 2, section 3):
+// detect and track the lamps (vision::LampTracker), give each new track the map lamp the
+// odometry-predicted pose says it is (LampLabeller), measure the pose from the labelled lamps
+// (measure_pose). Identical lamps are the normal case: a label comes from geometry, never looks.
+
+#include <Eigen/Core>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <vector>
+
+#include "lampnav/core/time.hpp"
+#include "lampnav/fusion/pose_from_lamps.hpp"
+#include "lampnav/graph/map.hpp"
+#include "lampnav/vision/lamp_tracker.hpp"
+
+namespace lampnav::fusion {
+
+struct LabellerOptions {
+  double gate_probability = 0.99;  // chi-square gate on the predicted centre and axis
+  double pixel_sigma = 1.0;        // px, a detection's centre as far as labelling is concerned
+  double orientation_sigma = 0.02; // rad, its axis
+  double tilt_sigma = 0.0087;      // rad, floor bumps
+  double map_sigma = 0.005;        // m, survey error of the map's lamps
+  double candidate_radius = 6.0;   // m, lamps considered when the pose is in no node's region
+  void validate() const;           // throws InputError naming the field
+};
+
+enum class LabelOutcome { labelled, no_candidate, ambiguous, partial_view };
+const char* to_string(LabelOutcome outcome);
+
+struct LabelResult {
+  LabelOutcome outcome = LabelOutcome::no_candidate;
+  const graph::Lamp* lamp = nullptr;
+  double d2 = 0;           // squared Mahalanobis distance of the chosen lamp
+  int in_gate = 0;         // candidates inside the gate
+  int candidates = 0;      // lamps of the current and adjacent nodes that were tried
+};
+
+// Labels one detection with a map lamp from the predicted pose and its covariance: candidates are
+// the lamps of the node the pose is in and of the nodes next to it; each is projected, gated by
+// the innovation covariance H P H^T + R, and only a lone lamp inside the gate is accepted. A
+// failed lamp is simply absent, so it cannot shift the labels of the ones after it.
+class LampLabeller {
+ public:
+  LampLabeller(const graph::TopologicalMap& map, const CameraDescription& camera,
+               const LabellerOptions& options = {});
+  LabelResult label(const vision::LampDetection& detection, const Pose2& predicted,
+                    const Eigen::Matrix3d& covariance, const std::set<LampId>& taken = {}) const;
+  std::vector<const graph::Lamp*> candidates(const Pose2& predicted) const;
+
+ private:
+  const graph::TopologicalMap* map_;
+  CeilingGeometry geometry_;
+  double fx_;
+  LabellerOptions o_;
+  double gate_;
+};
+
+// The detector's shape prior from a map's lamps and the camera's height: the most common lamp
+// size, and the range of lamp heights above the camera. Throws InputError when the map has no
+// lamp above the camera.
+vision::LampShapePrior shape_prior_for(const graph::TopologicalMap& map,
+                                       const CameraDescription& camera);
+
+struct CeilingPipelineOptions {
+  vision::LampDetectorOptions detector;
+  vision::LampTrackerOptions tracker;
+  LabellerOptions labeller;
+  PoseMeasurementOptions measurement;
+  void validate() const;
+};
+
+struct ObservedLamp {
+  int track_id = 0;
+  const graph::Lamp* lamp = nullptr;  // null while unlabelled
+  LabelOutcome outcome = LabelOutcome::no_candidate;  // of this frame's labelling attempt
+  vision::LampDetection detection;
+};
+
+struct CeilingObservation {
+  Stamp stamp;  // capture time
+  std::vector<ObservedLamp> lamps;
+  std::vector<int> ended_tracks;
+  std::optional<PoseMeasurement> measurement;
+  std::string no_measurement_reason;  // when lamps were seen but gave no measurement
+  vision::DetectionStats detection;
+};
+
+class CeilingPipeline {
+ public:
+  CeilingPipeline(const graph::TopologicalMap& map, const CameraDescription& camera,
+                  const CeilingPipelineOptions& options = {});
+  ~CeilingPipeline();
+  CeilingPipeline(CeilingPipeline&&) noexcept;
+
+  // One frame captured at `stamp`, with the pose predicted for that instant and its covariance.
+  // Throws InputError for a frame that is not an image of the camera (nothing else changes).
+  CeilingObservation process(Stamp stamp, const vision::ImageView& image, const Pose2& predicted,
+                             const Eigen::Matrix3d& covariance);
+  // Forgets the tracks and their labels (after a kidnap: the old labels are worthless).
+  void reset();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lampnav::fusion

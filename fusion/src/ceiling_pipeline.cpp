@@ -1,0 +1,250 @@
+#include "lampnav/fusion/ceiling_pipeline.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "lampnav/core/error.hpp"
+#include "lampnav/fusion/chi_square.hpp"
+
+namespace lampnav::fusion {
+
+using Eigen::Matrix3d;
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+const char* to_string(LabelOutcome outcome) {
+  switch (outcome) {
+    case LabelOutcome::labelled:
+      return "labelled";
+    case LabelOutcome::no_candidate:
+      return "no lamp expected there";
+    case LabelOutcome::ambiguous:
+      return "ambiguous";
+    case LabelOutcome::partial_view:
+      return "partial view";
+  }
+  return "?";
+}
+
+void LabellerOptions::validate() const {
+  auto fail = [](const char* field, const char* msg) {
+    throw InputError({"", "labeller options", field}, msg);
+  };
+  if (!(gate_probability > 0.5 && gate_probability < 1))
+    fail("gate_probability", "must be between 0.5 and 1");
+  if (!(pixel_sigma > 0)) fail("pixel_sigma", "must be positive");
+  if (!(orientation_sigma > 0)) fail("orientation_sigma", "must be positive");
+  if (!(tilt_sigma >= 0 && tilt_sigma < 0.5)) fail("tilt_sigma", "must be 0 to 0.5 rad");
+  if (!(map_sigma > 0)) fail("map_sigma", "must be positive");
+  if (!(candidate_radius > 0)) fail("candidate_radius", "must be positive");
+}
+
+void CeilingPipelineOptions::validate() const {
+  detector.validate();
+  tracker.validate();
+  labeller.validate();
+  measurement.validate();
+}
+
+namespace {
+double wrap_half(double a) {
+  a = std::remainder(a, M_PI);
+  return a <= -M_PI / 2 ? a + M_PI : a;
+}
+}  // namespace
+
+LampLabeller::LampLabeller(const graph::TopologicalMap& map, const CameraDescription& camera,
+                           const LabellerOptions& options)
+    : map_(&map), geometry_(camera), fx_(camera.pinhole.fx), o_(options) {
+  o_.validate();
+  if (camera.model != CameraModelKind::pinhole)
+    throw Error("the ceiling camera '" + camera.name + "' must be a pinhole camera");
+  gate_ = chi_square_quantile(o_.gate_probability, 3);
+}
+
+std::vector<const graph::Lamp*> LampLabeller::candidates(const Pose2& predicted) const {
+  const graph::Node* here = map_->node_containing(predicted.translation());
+  if (!here) return map_->lamps_within(predicted.translation(), o_.candidate_radius);
+  std::vector<NodeId> nodes{here->id};
+  for (const auto* e : map_->out_edges(here->id)) nodes.push_back(e->end);
+  for (const auto* e : map_->in_edges(here->id)) nodes.push_back(e->start);
+  std::sort(nodes.begin(), nodes.end());
+  nodes.erase(std::unique(nodes.begin(), nodes.end()), nodes.end());
+  std::vector<const graph::Lamp*> out;
+  for (NodeId id : nodes)
+    for (const auto& l : map_->node(id).lamps) out.push_back(&l);
+  return out;
+}
+
+LabelResult LampLabeller::label(const vision::LampDetection& d, const Pose2& predicted,
+                                const Matrix3d& P, const std::set<LampId>& taken) const {
+  LabelResult r;
+  if (d.view == vision::LampView::partial) {
+    r.outcome = LabelOutcome::partial_view;  // its centre is not the lamp's: wait for more
+    return r;
+  }
+  double best = 1e300;
+  for (const graph::Lamp* lamp : candidates(predicted)) {
+    if (taken.count(lamp->id)) continue;
+    Eigen::Matrix<double, 2, 3> Hn;
+    const auto n = geometry_.predict(predicted, lamp->xyz, &Hn);
+    if (!n) continue;
+    ++r.candidates;
+    const double dz = lamp->xyz.z() - geometry_.mount_origin().z();
+    const double sn = o_.pixel_sigma / fx_, sm = o_.map_sigma / dz;
+    // Innovation on (centre, axis). The axis turns with the heading one for one (an upward
+    // camera); round lamps have no axis and are gated on the centre alone.
+    const bool axis = lamp->shape == graph::LampShape::rectangle && lamp->length > lamp->width;
+    Eigen::Matrix<double, 3, 3> H = Eigen::Matrix3d::Zero();
+    H.topRows<2>() = Hn;
+    Vector3d nu = Vector3d::Zero();
+    nu.head<2>() = d.centre - *n;
+    Matrix3d R = Matrix3d::Zero();
+    R.topLeftCorner<2, 2>() =
+        (sn * sn + sm * sm + o_.tilt_sigma * o_.tilt_sigma) * Eigen::Matrix2d::Identity();
+    if (axis) {
+      const auto o = geometry_.predict_orientation(predicted, lamp->xyz, lamp->yaw);
+      const Pose2 turned(predicted.x(), predicted.y(), predicted.yaw() + 1e-6);
+      const auto o2 = geometry_.predict_orientation(turned, lamp->xyz, lamp->yaw);
+      if (!o || !o2) continue;
+      H(2, 2) = wrap_half(*o2 - *o) / 1e-6;
+      nu(2) = wrap_half(d.orientation - *o);
+      R(2, 2) = o_.orientation_sigma * o_.orientation_sigma;
+    } else {
+      R(2, 2) = 1.0;
+      H(2, 2) = 0;
+    }
+    const Matrix3d S = H * P * H.transpose() + R;
+    const double d2 = nu.dot(S.ldlt().solve(nu));
+    if (d2 < gate_) ++r.in_gate;
+    if (d2 < best) {
+      best = d2;
+      r.lamp = lamp;
+      r.d2 = d2;
+    }
+  }
+  if (r.in_gate == 1) {
+    r.outcome = LabelOutcome::labelled;
+  } else {
+    r.outcome = r.in_gate == 0 ? LabelOutcome::no_candidate : LabelOutcome::ambiguous;
+    r.lamp = nullptr;
+  }
+  return r;
+}
+
+vision::LampShapePrior shape_prior_for(const graph::TopologicalMap& map,
+                                       const CameraDescription& camera) {
+  const double cam_z = camera.mount.xyz.z();
+  std::map<std::pair<long, long>, int> sizes;  // (length, width) in mm -> count
+  double lo = 1e9, hi = -1e9;
+  std::vector<double> heights;
+  int discs = 0, rects = 0;
+  for (const auto& n : map.nodes()) {
+    for (const auto& l : n.lamps) {
+      const double dz = l.xyz.z() - cam_z;
+      if (dz <= 0.1) continue;
+      ++sizes[{std::lround(l.length * 1000), std::lround(l.width * 1000)}];
+      lo = std::min(lo, dz);
+      hi = std::max(hi, dz);
+      heights.push_back(dz);
+      (l.shape == graph::LampShape::disc ? discs : rects) += 1;
+    }
+  }
+  if (heights.empty())
+    throw InputError({map.name(), "lamps", ""}, "no lamp is above the ceiling camera");
+  const auto common = std::max_element(sizes.begin(), sizes.end(), [](const auto& a, const auto& b) {
+    return a.second < b.second;
+  });
+  std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
+  vision::LampShapePrior p;
+  p.rectangle = rects >= discs;
+  p.length = common->first.first / 1000.0;
+  p.width = p.rectangle ? common->first.second / 1000.0 : p.length;
+  p.min_distance = lo;
+  p.max_distance = hi;
+  p.nominal_distance = heights[heights.size() / 2];
+  return p;
+}
+
+struct CeilingPipeline::Impl {
+  const graph::TopologicalMap* map;
+  CameraDescription camera;
+  CeilingPipelineOptions o;
+  vision::LampTracker tracker;
+  LampLabeller labeller;
+  CeilingGeometry geometry;
+  std::map<int, const graph::Lamp*> label_of_track;
+
+  Impl(const graph::TopologicalMap& m, const CameraDescription& c, const CeilingPipelineOptions& opt)
+      : map(&m),
+        camera(c),
+        o(opt),
+        tracker(c, shape_prior_for(m, c), opt.detector, opt.tracker),
+        labeller(m, c, opt.labeller),
+        geometry(c) {
+    o.validate();
+  }
+};
+
+CeilingPipeline::CeilingPipeline(const graph::TopologicalMap& map, const CameraDescription& camera,
+                                 const CeilingPipelineOptions& options)
+    : impl_(std::make_unique<Impl>(map, camera, options)) {}
+CeilingPipeline::~CeilingPipeline() = default;
+CeilingPipeline::CeilingPipeline(CeilingPipeline&&) noexcept = default;
+
+void CeilingPipeline::reset() {
+  impl_->tracker.reset();
+  impl_->label_of_track.clear();
+}
+
+CeilingObservation CeilingPipeline::process(Stamp stamp, const vision::ImageView& image,
+                                            const Pose2& predicted, const Matrix3d& P) {
+  Impl& m = *impl_;
+  const vision::TrackedFrame frame = m.tracker.process(image);
+  CeilingObservation out;
+  out.stamp = stamp;
+  out.detection = frame.stats;
+  out.ended_tracks = frame.ended;
+  for (int id : frame.ended) m.label_of_track.erase(id);
+  // Lamps held by live tracks are not offered to new ones (one lamp, one track).
+  std::set<LampId> taken;
+  for (const auto& t : frame.lamps) {
+    const auto it = m.label_of_track.find(t.track_id);
+    if (it != m.label_of_track.end()) taken.insert(it->second->id);
+  }
+  std::vector<LabelledLamp> labelled;
+  for (const auto& t : frame.lamps) {
+    ObservedLamp ob;
+    ob.track_id = t.track_id;
+    ob.detection = t.detection;
+    const auto it = m.label_of_track.find(t.track_id);
+    if (it != m.label_of_track.end()) {
+      ob.lamp = it->second;
+      ob.outcome = LabelOutcome::labelled;
+    } else {
+      const LabelResult r = m.labeller.label(t.detection, predicted, P, taken);
+      ob.outcome = r.outcome;
+      if (r.outcome == LabelOutcome::labelled) {
+        ob.lamp = r.lamp;
+        m.label_of_track[t.track_id] = r.lamp;
+        taken.insert(r.lamp->id);
+      }
+    }
+    if (ob.lamp && ob.detection.view != vision::LampView::partial)
+      labelled.push_back({ob.lamp, ob.detection});
+    out.lamps.push_back(ob);
+  }
+  if (!labelled.empty()) {
+    std::string why;
+    out.measurement = measure_pose(m.geometry, m.camera.pinhole.fx, labelled, predicted, stamp,
+                                   m.o.measurement, &why);
+    if (!out.measurement) out.no_measurement_reason = why;
+  } else if (!out.lamps.empty()) {
+    out.no_measurement_reason = "no labelled lamp in full view";
+  }
+  return out;
+}
+
+}  // namespace lampnav::fusion

@@ -1,0 +1,174 @@
+#include "lampnav/fusion/pose_from_lamps.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Dense>
+#include <cmath>
+
+#include "lampnav/core/error.hpp"
+#include "lampnav/fusion/chi_square.hpp"
+
+namespace lampnav::fusion {
+
+using Eigen::Matrix2d;
+using Eigen::Matrix3d;
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+void PoseMeasurementOptions::validate() const {
+  auto positive = [](double v, const char* field) {
+    if (!(v > 0 && std::isfinite(v)))
+      throw InputError({"", "pose measurement options", field}, "must be positive");
+  };
+  positive(pixel_sigma, "pixel_sigma");
+  positive(completed_pixel_sigma, "completed_pixel_sigma");
+  positive(orientation_sigma, "orientation_sigma");
+  positive(completed_orientation_sigma, "completed_orientation_sigma");
+  positive(map_sigma, "map_sigma");
+  if (!(consistency_probability > 0.5 && consistency_probability < 1))
+    throw InputError({"", "pose measurement options", "consistency_probability"},
+                     "must be between 0.5 and 1");
+  if (!(tilt_sigma >= 0 && tilt_sigma < 0.5))
+    throw InputError({"", "pose measurement options", "tilt_sigma"}, "must be 0 to 0.5 rad");
+}
+
+namespace {
+
+// (-pi/2, pi/2]: lamp axes have no direction.
+double wrap_half(double a) {
+  a = std::remainder(a, M_PI);
+  return a <= -M_PI / 2 ? a + M_PI : a;
+}
+
+struct Term {
+  Vector2d map_xy;      // lamp centre in the map
+  Vector2d base;        // where the detection puts it in the base frame
+  Matrix2d base_cov;    // its covariance (pixel noise through the geometry)
+  bool has_axis = false;
+  double map_yaw = 0;   // the lamp's axis in the map
+  double base_yaw = 0;  // the detected axis in the base frame
+  double axis_var = 0;
+};
+
+}  // namespace
+
+std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry, double fx,
+                                            const std::vector<LabelledLamp>& lamps,
+                                            const Pose2& predicted, Stamp stamp,
+                                            const PoseMeasurementOptions& o, std::string* why) {
+  auto refuse = [&](const std::string& reason) -> std::optional<PoseMeasurement> {
+    if (why) *why = reason;
+    return std::nullopt;
+  };
+  std::vector<Term> terms;
+  double height_sum = 0;
+  for (const auto& l : lamps) {
+    const auto& d = l.detection;
+    if (!l.lamp || d.view == vision::LampView::partial) continue;
+    const bool completed = d.view == vision::LampView::completed;
+    const double sn = (completed ? o.completed_pixel_sigma : o.pixel_sigma) / fx;
+    Term t;
+    Matrix2d J;
+    const auto b = geometry.base_point(d.centre, l.lamp->xyz.z(), &J);
+    if (!b) continue;
+    t.map_xy = l.lamp->xyz.head<2>();
+    t.base = *b;
+    t.base_cov = sn * sn * J * J.transpose();
+    if (l.lamp->shape == graph::LampShape::rectangle && l.lamp->length > l.lamp->width) {
+      const auto dir = geometry.base_direction(d.centre, d.orientation, l.lamp->xyz.z());
+      if (dir) {
+        t.has_axis = true;
+        t.map_yaw = l.lamp->yaw;
+        t.base_yaw = *dir;
+        const double so = completed ? o.completed_orientation_sigma : o.orientation_sigma;
+        t.axis_var = so * so;
+      }
+    }
+    terms.push_back(t);
+    height_sum += l.lamp->xyz.z();
+  }
+  if (terms.empty()) return refuse("no fully visible or completed labelled lamp");
+  int axes = 0;
+  for (const auto& t : terms) axes += t.has_axis;
+  if (terms.size() == 1 && axes == 0) return refuse("one round lamp does not give the heading");
+
+  // Initial heading: a lamp's axis, on the branch (of two, pi apart) nearest the prediction;
+  // without axes, the direction between the first two lamps.
+  double yaw = predicted.yaw();
+  if (axes > 0) {
+    for (const auto& t : terms) {
+      if (!t.has_axis) continue;
+      const double y0 = t.map_yaw - t.base_yaw;
+      yaw = predicted.yaw() + wrap_half(y0 - predicted.yaw());
+      break;
+    }
+  } else {
+    const Vector2d dm = terms[1].map_xy - terms[0].map_xy, db = terms[1].base - terms[0].base;
+    yaw = std::atan2(dm.y(), dm.x()) - std::atan2(db.y(), db.x());
+  }
+  auto rot = [](double a) {
+    Matrix2d R;
+    R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+    return R;
+  };
+  Vector2d t0 = Vector2d::Zero();
+  for (const auto& t : terms) t0 += t.map_xy - rot(yaw) * t.base;
+  Vector3d x(t0.x() / terms.size(), t0.y() / terms.size(), yaw);
+
+  // Gauss-Newton on (x, y, yaw): position residuals m - (t + R b), axis residuals wrapped mod pi.
+  Matrix3d H = Matrix3d::Zero();
+  double chi2 = 0;
+  for (int it = 0; it < 8; ++it) {
+    H.setZero();
+    Vector3d g = Vector3d::Zero();
+    chi2 = 0;
+    const Matrix2d R = rot(x.z());
+    Matrix2d dR;
+    dR << -std::sin(x.z()), -std::cos(x.z()), std::cos(x.z()), -std::sin(x.z());
+    for (const auto& t : terms) {
+      const Vector2d e = t.map_xy - x.head<2>() - R * t.base;
+      Eigen::Matrix<double, 2, 3> J;
+      J.leftCols<2>() = -Matrix2d::Identity();
+      J.col(2) = -dR * t.base;
+      const Matrix2d W =
+          (R * t.base_cov * R.transpose() + o.map_sigma * o.map_sigma * Matrix2d::Identity())
+              .inverse();
+      H += J.transpose() * W * J;
+      g += J.transpose() * W * e;
+      chi2 += e.dot(W * e);
+      if (t.has_axis) {
+        const double r = wrap_half(t.map_yaw - x.z() - t.base_yaw);
+        H(2, 2) += 1.0 / t.axis_var;
+        g(2) += -r / t.axis_var;
+        chi2 += r * r / t.axis_var;
+      }
+    }
+    const Vector3d step = -H.ldlt().solve(g);
+    if (!step.allFinite()) return refuse("the lamps do not determine the pose");
+    x += step;
+    if (step.head<2>().norm() < 1e-9 && std::fabs(step.z()) < 1e-10) break;
+  }
+  const int dof = static_cast<int>(2 * terms.size()) + axes - 3;
+  // Beyond six dof (four lamps and more) the gate scales the six-dof quantile per dof.
+  const double limit = dof <= 0 ? 0
+                       : dof <= 6
+                           ? chi_square_quantile(o.consistency_probability, dof)
+                           : chi_square_quantile(o.consistency_probability, 6) * dof / 6.0;
+  if (dof > 0 && chi2 > limit)
+    return refuse("the lamps disagree on the pose (chi2 " + std::to_string(chi2) + " over " +
+                  std::to_string(dof) + " dof): a lamp is mislabelled");
+  PoseMeasurement m;
+  m.stamp = stamp;
+  m.pose = Pose2(x.x(), x.y(), wrap_angle(x.z()));
+  m.covariance = H.inverse();
+  // A tilt moves the view of every lamp alike, by the lamp height times the angle.
+  const double shift = height_sum / terms.size() * o.tilt_sigma;
+  m.covariance.topLeftCorner<2, 2>() += shift * shift * Matrix2d::Identity();
+  m.covariance = 0.5 * (m.covariance + m.covariance.transpose()).eval();
+  m.chi2 = chi2;
+  m.dof = std::max(dof, 0);
+  for (const auto& l : lamps)
+    if (l.lamp && l.detection.view != vision::LampView::partial) m.lamps.push_back(l.lamp->id);
+  return m;
+}
+
+}  // namespace lampnav::fusion
