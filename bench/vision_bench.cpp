@@ -4,10 +4,10 @@
 
 #include <benchmark/benchmark.h>
 
-#include <opencv2/features2d.hpp>
-#include <random>
 #include <visp3/blob/vpDot2.h>
 #include <visp3/core/vpImage.h>
+#include <opencv2/features2d.hpp>
+#include <random>
 
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/sim/renderers.hpp"

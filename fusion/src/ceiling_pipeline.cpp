@@ -154,9 +154,8 @@ vision::LampShapePrior shape_prior_for(const graph::TopologicalMap& map,
   }
   if (heights.empty())
     throw InputError({map.name(), "lamps", ""}, "no lamp is above the ceiling camera");
-  const auto common = std::max_element(sizes.begin(), sizes.end(), [](const auto& a, const auto& b) {
-    return a.second < b.second;
-  });
+  const auto common = std::max_element(
+      sizes.begin(), sizes.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
   std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
   vision::LampShapePrior p;
   p.rectangle = rects >= discs;
@@ -177,7 +176,8 @@ struct CeilingPipeline::Impl {
   CeilingGeometry geometry;
   std::map<int, const graph::Lamp*> label_of_track;
 
-  Impl(const graph::TopologicalMap& m, const CameraDescription& c, const CeilingPipelineOptions& opt)
+  Impl(const graph::TopologicalMap& m, const CameraDescription& c,
+       const CeilingPipelineOptions& opt)
       : map(&m),
         camera(c),
         o(opt),

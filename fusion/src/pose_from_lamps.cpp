@@ -40,9 +40,9 @@ double wrap_half(double a) {
 }
 
 struct Term {
-  Vector2d map_xy;      // lamp centre in the map
-  Vector2d base;        // where the detection puts it in the base frame
-  Matrix2d base_cov;    // its covariance (pixel noise through the geometry)
+  Vector2d map_xy;    // lamp centre in the map
+  Vector2d base;      // where the detection puts it in the base frame
+  Matrix2d base_cov;  // its covariance (pixel noise through the geometry)
   bool has_axis = false;
   double map_yaw = 0;   // the lamp's axis in the map
   double base_yaw = 0;  // the detected axis in the base frame
@@ -149,10 +149,9 @@ std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry, dou
   }
   const int dof = static_cast<int>(2 * terms.size()) + axes - 3;
   // Beyond six dof (four lamps and more) the gate scales the six-dof quantile per dof.
-  const double limit = dof <= 0 ? 0
-                       : dof <= 6
-                           ? chi_square_quantile(o.consistency_probability, dof)
-                           : chi_square_quantile(o.consistency_probability, 6) * dof / 6.0;
+  const double limit = dof <= 0   ? 0
+                       : dof <= 6 ? chi_square_quantile(o.consistency_probability, dof)
+                                  : chi_square_quantile(o.consistency_probability, 6) * dof / 6.0;
   if (dof > 0 && chi2 > limit)
     return refuse("the lamps disagree on the pose (chi2 " + std::to_string(chi2) + " over " +
                   std::to_string(dof) + " dof): a lamp is mislabelled");

@@ -4,9 +4,9 @@
 
 #include "lampnav/fusion/ceiling_geometry.hpp"
 #include "lampnav/fusion/ceiling_pipeline.hpp"
-#include "lampnav/graph/geojson.hpp"
 #include "lampnav/fusion/chi_square.hpp"
 #include "lampnav/fusion/pose_from_lamps.hpp"
+#include "lampnav/graph/geojson.hpp"
 #include "lampnav_test.hpp"
 
 namespace lampnav::fusion {
@@ -17,8 +17,8 @@ using Eigen::Vector2d;
 using Eigen::Vector3d;
 
 CameraDescription ceiling_camera(Eigen::Vector3d rpy = Vector3d::Zero()) {
-  CameraDescription c =
-      *read_robot_description(test::source_path("maps/robots/pioneer.json")).find_camera("ceiling_camera");
+  CameraDescription c = *read_robot_description(test::source_path("maps/robots/pioneer.json"))
+                             .find_camera("ceiling_camera");
   c.mount.rpy = rpy;
   return c;
 }
@@ -104,8 +104,8 @@ TEST(PoseFromLamps, CovarianceMatchesMonteCarloSpread) {
   const graph::Lamp a = rect("A", 3.0, 1.0, 0.0), b = rect("B", 5.25, 1.0, 0.0);
   const Pose2 truth(4.0, 1.1, 0.1);
   PoseMeasurementOptions o;
-  o.tilt_sigma = 0;     // the simulation below has no tilt
-  o.map_sigma = 1e-6;   // nor survey error
+  o.tilt_sigma = 0;    // the simulation below has no tilt
+  o.map_sigma = 1e-6;  // nor survey error
   std::mt19937 rng(3);
   const double sn = o.pixel_sigma / 300;
   Eigen::Matrix3d reported = Eigen::Matrix3d::Zero(), spread = Eigen::Matrix3d::Zero();
@@ -138,8 +138,8 @@ TEST(PoseFromLamps, RefusesWhatCannotGiveAPose) {
   std::mt19937 rng(1);
   const Pose2 truth(3.1, 1.0, 0.2);
   std::string why;
-  EXPECT_FALSE(measure_pose(g, 300, {{&disc, see(g, truth, disc, rng, 0, 0)}}, truth, Stamp{}, {},
-                            &why));
+  EXPECT_FALSE(
+      measure_pose(g, 300, {{&disc, see(g, truth, disc, rng, 0, 0)}}, truth, Stamp{}, {}, &why));
   EXPECT_EQ(why, "one round lamp does not give the heading");
   // Two lamps labelled the wrong way round disagree.
   const graph::Lamp a = rect("A", 3.0, 1.0, 0.0), b = rect("B", 4.2, 1.9, 1.0);

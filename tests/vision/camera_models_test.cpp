@@ -67,12 +67,12 @@ TEST(PinholeCamera, JacobiansMatchNumericalDerivatives) {
   std::uniform_real_distribution<double> xy(-0.6, 0.6), z(1.0, 4.0);
   for (int i = 0; i < 500; ++i) {
     const Vector2d n(xy(rng), xy(rng));
-    const auto Jd = test::numerical_jacobian<2, 2>([&](const Vector2d& q) { return cam.distort(q); },
-                                                   n);
+    const auto Jd =
+        test::numerical_jacobian<2, 2>([&](const Vector2d& q) { return cam.distort(q); }, n);
     EXPECT_LT((cam.distort_jacobian(n) - Jd).norm(), 1e-7);
     const Vector3d p(xy(rng) * 2, xy(rng) * 2, z(rng));
-    const auto Jp = test::numerical_jacobian<2, 3>(
-        [&](const Vector3d& q) { return *cam.project(q); }, p);
+    const auto Jp =
+        test::numerical_jacobian<2, 3>([&](const Vector3d& q) { return *cam.project(q); }, p);
     EXPECT_LT((cam.project_jacobian(p) - Jp).norm(), 1e-5 * (1 + Jp.norm()));
     // Pixel <-> undistorted normalized coordinates round trip.
     const Vector2d px = cam.pixel_of_normalized(n * 0.5);
@@ -85,8 +85,8 @@ TEST(PinholeCamera, JacobianWithTangentialDistortion) {
   d.pinhole.distortion = {-0.2, 0.05, 0.003, -0.002, 0.01};
   const PinholeCamera cam(d);
   for (const Vector2d& n : {Vector2d(0.3, -0.2), Vector2d(-0.45, 0.1), Vector2d(0, 0)}) {
-    const auto Jd = test::numerical_jacobian<2, 2>([&](const Vector2d& q) { return cam.distort(q); },
-                                                   n);
+    const auto Jd =
+        test::numerical_jacobian<2, 2>([&](const Vector2d& q) { return cam.distort(q); }, n);
     EXPECT_LT((cam.distort_jacobian(n) - Jd).norm(), 1e-7);
     EXPECT_LT((cam.undistort(cam.distort(n)) - n).norm(), 1e-12);
   }
@@ -101,8 +101,8 @@ TEST(FisheyeCamera, JacobianMatchesNumericalDerivative) {
       dist(1.0, 12.0);
   for (int i = 0; i < 500; ++i) {
     const double t = th(rng), p = ph(rng);
-    const Vector3d pt = dist(rng) * Vector3d(std::sin(t) * std::cos(p),
-                                             std::sin(t) * std::sin(p), std::cos(t));
+    const Vector3d pt =
+        dist(rng) * Vector3d(std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t));
     const auto J = test::numerical_jacobian<2, 3>(
         [&](const Vector3d& q) { return *cam.project(q); }, pt, 1e-7);
     EXPECT_LT((cam.project_jacobian(pt) - J).norm(), 1e-4 * (1 + J.norm())) << "theta " << t;

@@ -30,12 +30,12 @@ LampShapePrior office_prior() {
 // The truth for one lamp in one frame: where its centre and axis appear, how much of it is seen.
 struct LampTruth {
   const graph::Lamp* lamp;
-  Vector2d centre_px;   // the image of the lamp's centre
-  Vector2d centroid_px; // the centroid of the lamp's image in undistorted coordinates (they
-                        // differ by up to half a pixel when floor bumps tilt the camera)
-  double orientation;  // in the normalized plane, mod pi
-  double visible;      // fraction of the face inside the image
-  bool fully_visible;  // face and fringe inside with a pixel to spare
+  Vector2d centre_px;    // the image of the lamp's centre
+  Vector2d centroid_px;  // the centroid of the lamp's image in undistorted coordinates (they
+                         // differ by up to half a pixel when floor bumps tilt the camera)
+  double orientation;    // in the normalized plane, mod pi
+  double visible;        // fraction of the face inside the image
+  bool fully_visible;    // face and fringe inside with a pixel to spare
 };
 
 LampTruth truth_of(const sim::CeilingRenderer& r, const PinholeCamera& model, const Pose2& pose,
@@ -82,7 +82,8 @@ LampTruth truth_of(const sim::CeilingRenderer& r, const PinholeCamera& model, co
   for (double s : {-l.length / 2 - m, l.length / 2 + m}) {
     for (double q : {-l.width / 2 - m, l.width / 2 + m}) {
       const auto p = at(s, q);
-      if (!p || p->x() < 1 || p->y() < 1 || p->x() > model.width() - 2 || p->y() > model.height() - 2)
+      if (!p || p->x() < 1 || p->y() < 1 || p->x() > model.width() - 2 ||
+          p->y() > model.height() - 2)
         t.fully_visible = false;
     }
   }
@@ -96,7 +97,8 @@ double angle_mod_pi(double a) {
 
 struct Score {
   int full_lamps = 0, full_found = 0, completed = 0, completable = 0, false_lamps = 0;
-  double max_centre_px = 0, max_centre_of_lamp_px = 0, max_orientation_deg = 0, max_completed_px = 0;
+  double max_centre_px = 0, max_centre_of_lamp_px = 0, max_orientation_deg = 0,
+         max_completed_px = 0;
   double sum_centre_px = 0;
 };
 
@@ -133,11 +135,12 @@ Score run_frames(const World& w, int frames, double bump_deg, std::uint64_t seed
         if (d.view != LampView::full || (d.centre_px - t.centre_px).norm() > 3) continue;
         ++s.full_found;
         const double e = (d.centre_px - t.centroid_px).norm();
-        s.max_centre_of_lamp_px = std::max(s.max_centre_of_lamp_px, (d.centre_px - t.centre_px).norm());
+        s.max_centre_of_lamp_px =
+            std::max(s.max_centre_of_lamp_px, (d.centre_px - t.centre_px).norm());
         s.sum_centre_px += e;
         s.max_centre_px = std::max(s.max_centre_px, e);
-        s.max_orientation_deg =
-            std::max(s.max_orientation_deg, angle_mod_pi(d.orientation - t.orientation) * 180 / M_PI);
+        s.max_orientation_deg = std::max(s.max_orientation_deg,
+                                         angle_mod_pi(d.orientation - t.orientation) * 180 / M_PI);
       }
     }
     for (const auto& d : det.lamps) {

@@ -257,8 +257,8 @@ struct LampDetector::Impl {
         w_max = std::max(w_max, 1.0 / det);
       }
     }
-    const double face = prior.rectangle ? prior.length * prior.width
-                                         : M_PI / 4 * prior.length * prior.length;
+    const double face =
+        prior.rectangle ? prior.length * prior.width : M_PI / 4 * prior.length * prior.length;
     area_nominal = face / (prior.nominal_distance * prior.nominal_distance);
     area_min = face / (prior.max_distance * prior.max_distance);
     area_max = face / (prior.min_distance * prior.min_distance);
@@ -381,7 +381,9 @@ bool LampDetector::Impl::measure(const Component& c, const ImageView& g, LampDet
   const int mw = c.u1 - c.u0 + 1 + 2 * pad, mh = c.v1 - c.v0 + 1 + 2 * pad;
   mask_width = mw;
   mask.assign(static_cast<std::size_t>(mw) * mh, 0);
-  auto mrow = [&](std::vector<std::uint8_t>& m, int y) { return m.data() + static_cast<std::size_t>(y) * mw; };
+  auto mrow = [&](std::vector<std::uint8_t>& m, int y) {
+    return m.data() + static_cast<std::size_t>(y) * mw;
+  };
   for (int k = 0; k < c.run_count; ++k) {
     const Run& run = runs[sorted_runs[c.first_run + k]];
     std::memset(mrow(mask, run.row - c.v0 + pad) + (run.u0 - c.u0 + pad), 1,
@@ -410,7 +412,8 @@ bool LampDetector::Impl::measure(const Component& c, const ImageView& g, LampDet
   int seed_d = 1 << 30;
   bool touches_border = false;  // after the opening: a fringe pixel at the border is no cut
   for (int v = c.v0; v <= c.v1; ++v) {
-    const std::uint8_t* row = opened.data() + static_cast<std::size_t>(v - c.v0 + pad) * mw + pad - c.u0;
+    const std::uint8_t* row =
+        opened.data() + static_cast<std::size_t>(v - c.v0 + pad) * mw + pad - c.u0;
     const std::size_t base = index(0, v);
     for (int u = c.u0; u <= c.u1; ++u) {
       if (!row[u]) continue;
@@ -518,13 +521,15 @@ bool LampDetector::Impl::complete(const Component& c, const ImageView& g, int pa
         const double gi = grey_at(u, v), go = grey_at(un, vn);
         const double t = gi > go ? std::clamp((gi - level) / (gi - go), 0.0, 1.0) : 0.5;
         const std::size_t a = index(u, v), b = index(un, vn);
-        edges.emplace_back(lut_x[a] + t * (lut_x[b] - lut_x[a]), lut_y[a] + t * (lut_y[b] - lut_y[a]));
+        edges.emplace_back(lut_x[a] + t * (lut_x[b] - lut_x[a]),
+                           lut_y[a] + t * (lut_y[b] - lut_y[a]));
       }
     }
   }
   if (edges.size() < 16 || border_n == 0) return false;
   const double half_a = prior.length / (2 * prior.nominal_distance);
-  const double half_b = (prior.rectangle ? prior.width : prior.length) / (2 * prior.nominal_distance);
+  const double half_b =
+      (prior.rectangle ? prior.width : prior.length) / (2 * prior.nominal_distance);
   const double px = 1.0 / model.parameters().fx;  // one pixel in normalized units (about)
   // Initial guesses: the visible centroid moved towards the cut, along and across the lamp, so
   // that the uncut end (or side) stays where it is seen.

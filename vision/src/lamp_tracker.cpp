@@ -13,7 +13,8 @@ void LampTrackerOptions::validate() const {
   if (max_tracks < 1 || max_tracks > 1000)
     throw InputError({"", "lamp tracker options", "max_tracks"}, "must be 1 to 1000");
   if (!(max_step_px > 0 && max_step_px < 10000))
-    throw InputError({"", "lamp tracker options", "max_step_px"}, "must be a positive number of px");
+    throw InputError({"", "lamp tracker options", "max_step_px"},
+                     "must be a positive number of px");
 }
 
 namespace {
@@ -76,7 +77,8 @@ TrackedFrame LampTracker::Impl::process(const ImageView& image) {
     const std::uint8_t* __restrict b = a + g.row_stride();
     std::uint8_t* __restrict dst = half.data() + static_cast<std::size_t>(v) * hw;
     for (int u = 0; u < hw; ++u) {
-      dst[u] = static_cast<std::uint8_t>((a[2 * u] + a[2 * u + 1] + b[2 * u] + b[2 * u + 1] + 2) >> 2);
+      dst[u] =
+          static_cast<std::uint8_t>((a[2 * u] + a[2 * u + 1] + b[2 * u] + b[2 * u + 1] + 2) >> 2);
     }
   }
   const vpImage<unsigned char> I(half.data(), static_cast<unsigned>(hh), static_cast<unsigned>(hw),

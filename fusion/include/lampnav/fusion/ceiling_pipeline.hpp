@@ -19,13 +19,13 @@
 namespace lampnav::fusion {
 
 struct LabellerOptions {
-  double gate_probability = 0.99;  // chi-square gate on the predicted centre and axis
-  double pixel_sigma = 1.0;        // px, a detection's centre as far as labelling is concerned
-  double orientation_sigma = 0.02; // rad, its axis
-  double tilt_sigma = 0.0087;      // rad, floor bumps
-  double map_sigma = 0.005;        // m, survey error of the map's lamps
-  double candidate_radius = 6.0;   // m, lamps considered when the pose is in no node's region
-  void validate() const;           // throws InputError naming the field
+  double gate_probability = 0.99;   // chi-square gate on the predicted centre and axis
+  double pixel_sigma = 1.0;         // px, a detection's centre as far as labelling is concerned
+  double orientation_sigma = 0.02;  // rad, its axis
+  double tilt_sigma = 0.0087;       // rad, floor bumps
+  double map_sigma = 0.005;         // m, survey error of the map's lamps
+  double candidate_radius = 6.0;    // m, lamps considered when the pose is in no node's region
+  void validate() const;            // throws InputError naming the field
 };
 
 enum class LabelOutcome { labelled, no_candidate, ambiguous, partial_view };
@@ -34,9 +34,9 @@ const char* to_string(LabelOutcome outcome);
 struct LabelResult {
   LabelOutcome outcome = LabelOutcome::no_candidate;
   const graph::Lamp* lamp = nullptr;
-  double d2 = 0;           // squared Mahalanobis distance of the chosen lamp
-  int in_gate = 0;         // candidates inside the gate
-  int candidates = 0;      // lamps of the current and adjacent nodes that were tried
+  double d2 = 0;       // squared Mahalanobis distance of the chosen lamp
+  int in_gate = 0;     // candidates inside the gate
+  int candidates = 0;  // lamps of the current and adjacent nodes that were tried
 };
 
 // Labels one detection with a map lamp from the predicted pose and its covariance: candidates are
@@ -75,7 +75,7 @@ struct CeilingPipelineOptions {
 
 struct ObservedLamp {
   int track_id = 0;
-  const graph::Lamp* lamp = nullptr;  // null while unlabelled
+  const graph::Lamp* lamp = nullptr;                  // null while unlabelled
   LabelOutcome outcome = LabelOutcome::no_candidate;  // of this frame's labelling attempt
   vision::LampDetection detection;
 };

@@ -20,15 +20,15 @@
 namespace lampnav::fusion {
 
 struct PoseMeasurementOptions {
-  double pixel_sigma = 0.3;              // px, centre of a fully visible lamp
-  double completed_pixel_sigma = 1.0;    // px, centre of a lamp completed at the border
-  double orientation_sigma = 0.004;      // rad, axis of a fully visible lamp (about 0.25 deg)
+  double pixel_sigma = 0.3;                    // px, centre of a fully visible lamp
+  double completed_pixel_sigma = 1.0;          // px, centre of a lamp completed at the border
+  double orientation_sigma = 0.004;            // rad, axis of a fully visible lamp (about 0.25 deg)
   double completed_orientation_sigma = 0.015;  // rad, axis of a completed lamp
-  double tilt_sigma = 0.0087;            // rad, camera swing on floor bumps (sim default 0.5 deg)
-  double map_sigma = 0.005;              // m, survey error of a lamp's position in the map
+  double tilt_sigma = 0.0087;  // rad, camera swing on floor bumps (sim default 0.5 deg)
+  double map_sigma = 0.005;    // m, survey error of a lamp's position in the map
   double consistency_probability = 0.9999;  // chi-square gate on the fit's residuals: beyond
                                             // it the lamps disagree (a mislabel), refused
-  void validate() const;                 // throws InputError naming the field
+  void validate() const;                    // throws InputError naming the field
 };
 
 struct LabelledLamp {

@@ -19,7 +19,11 @@ struct ImageView {
   std::size_t stride = 0;    // bytes from one row to the next; 0 means rows are packed
 
   static ImageView of(const Image8& image) {
-    return {image.pixels.data(), image.width, image.height, 1, 1,
+    return {image.pixels.data(),
+            image.width,
+            image.height,
+            1,
+            1,
             static_cast<std::size_t>(image.width)};
   }
   std::size_t row_bytes() const {

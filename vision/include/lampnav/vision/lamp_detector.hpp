@@ -22,13 +22,13 @@ namespace lampnav::vision {
 // What a lamp looks like from the camera: the emitting face and its distance above the camera's
 // optical centre. A map with lamps at several heights gives the range.
 struct LampShapePrior {
-  bool rectangle = true;         // rectangle (length x width), or disc (diameter = length)
-  double length = 1.2;           // m, long side or diameter
-  double width = 0.3;            // m, short side (= length for a disc)
-  double min_distance = 2.4;     // m, nearest lamp face above the camera
-  double max_distance = 2.4;     // m, farthest
-  double nominal_distance = 2.4; // m, used to complete cut lamps
-  void validate() const;         // throws InputError naming the field
+  bool rectangle = true;          // rectangle (length x width), or disc (diameter = length)
+  double length = 1.2;            // m, long side or diameter
+  double width = 0.3;             // m, short side (= length for a disc)
+  double min_distance = 2.4;      // m, nearest lamp face above the camera
+  double max_distance = 2.4;      // m, farthest
+  double nominal_distance = 2.4;  // m, used to complete cut lamps
+  void validate() const;          // throws InputError naming the field
 };
 
 struct LampDetectorOptions {
@@ -66,11 +66,11 @@ struct LampDetection {
 
 // Why blobs were not reported as lamps: counters of one frame.
 struct DetectionStats {
-  int blobs = 0;             // connected components above the threshold
-  int too_small = 0;         // including specks of noise and fringe
-  int too_large = 0;         // merged lamps, a saturated frame
-  int wrong_shape = 0;       // full blobs whose axes do not match the prior
-  int completion_failed = 0; // cut lamps whose edges did not fit the shape (reported partial)
+  int blobs = 0;              // connected components above the threshold
+  int too_small = 0;          // including specks of noise and fringe
+  int too_large = 0;          // merged lamps, a saturated frame
+  int wrong_shape = 0;        // full blobs whose axes do not match the prior
+  int completion_failed = 0;  // cut lamps whose edges did not fit the shape (reported partial)
 };
 
 struct LampDetections {

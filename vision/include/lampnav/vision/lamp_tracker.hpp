@@ -13,10 +13,10 @@
 namespace lampnav::vision {
 
 struct LampTrackerOptions {
-  int max_tracks = 32;               // live tracks at most; new lamps beyond it are not tracked
-  double max_step_px = 60.0;         // px: a tracked centre moving more than this in one frame
-                                     // means the blob was confused with another: the track ends
-  void validate() const;             // throws InputError naming the field
+  int max_tracks = 32;        // live tracks at most; new lamps beyond it are not tracked
+  double max_step_px = 60.0;  // px: a tracked centre moving more than this in one frame
+                              // means the blob was confused with another: the track ends
+  void validate() const;      // throws InputError naming the field
 };
 
 struct TrackedLamp {
