@@ -13,6 +13,13 @@ double wrap_angle(double a) {
   return w;
 }
 
+double wrap_axis_angle(double a) {
+  if (!std::isfinite(a)) return a;
+  double w = std::remainder(a, M_PI);
+  if (w <= -M_PI / 2) w += M_PI;
+  return w;
+}
+
 Pose2::Pose2(double x, double y, double yaw) : t_(x, y), yaw_(wrap_angle(yaw)) {}
 Pose2::Pose2(const Eigen::Vector2d& t, double yaw) : t_(t), yaw_(wrap_angle(yaw)) {}
 

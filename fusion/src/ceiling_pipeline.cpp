@@ -48,13 +48,6 @@ void CeilingPipelineOptions::validate() const {
   measurement.validate();
 }
 
-namespace {
-double wrap_half(double a) {
-  a = std::remainder(a, M_PI);
-  return a <= -M_PI / 2 ? a + M_PI : a;
-}
-}  // namespace
-
 LampLabeller::LampLabeller(const graph::TopologicalMap& map, const CameraDescription& camera,
                            const LabellerOptions& options)
     : map_(&map), geometry_(camera), fx_(camera.pinhole.fx), o_(options) {
@@ -109,8 +102,8 @@ LabelResult LampLabeller::label(const vision::LampDetection& d, const Pose2& pre
       const Pose2 turned(predicted.x(), predicted.y(), predicted.yaw() + 1e-6);
       const auto o2 = geometry_.predict_orientation(turned, lamp->xyz, lamp->yaw);
       if (!o || !o2) continue;
-      H(2, 2) = wrap_half(*o2 - *o) / 1e-6;
-      nu(2) = wrap_half(d.orientation - *o);
+      H(2, 2) = wrap_axis_angle(*o2 - *o) / 1e-6;
+      nu(2) = wrap_axis_angle(d.orientation - *o);
       R(2, 2) = o_.orientation_sigma * o_.orientation_sigma;
     } else {
       R(2, 2) = 1.0;

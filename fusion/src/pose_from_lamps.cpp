@@ -33,12 +33,6 @@ void PoseMeasurementOptions::validate() const {
 
 namespace {
 
-// (-pi/2, pi/2]: lamp axes have no direction.
-double wrap_half(double a) {
-  a = std::remainder(a, M_PI);
-  return a <= -M_PI / 2 ? a + M_PI : a;
-}
-
 struct Term {
   Vector2d map_xy;    // lamp centre in the map
   Vector2d base;      // where the detection puts it in the base frame
@@ -98,7 +92,7 @@ std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry, dou
     for (const auto& t : terms) {
       if (!t.has_axis) continue;
       const double y0 = t.map_yaw - t.base_yaw;
-      yaw = predicted.yaw() + wrap_half(y0 - predicted.yaw());
+      yaw = predicted.yaw() + wrap_axis_angle(y0 - predicted.yaw());
       break;
     }
   } else {
@@ -136,7 +130,7 @@ std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry, dou
       g += J.transpose() * W * e;
       chi2 += e.dot(W * e);
       if (t.has_axis) {
-        const double r = wrap_half(t.map_yaw - x.z() - t.base_yaw);
+        const double r = wrap_axis_angle(t.map_yaw - x.z() - t.base_yaw);
         H(2, 2) += 1.0 / t.axis_var;
         g(2) += -r / t.axis_var;
         chi2 += r * r / t.axis_var;

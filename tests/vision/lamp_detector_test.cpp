@@ -9,6 +9,7 @@
 #include "lampnav/vision/camera_models.hpp"
 #include "lampnav/vision/lamp_detector.hpp"
 #include "lampnav_test.hpp"
+#include "office_world.hpp"
 
 namespace lampnav::vision {
 namespace {
@@ -16,11 +17,7 @@ namespace {
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
-struct World {
-  RobotDescription robot = read_robot_description(test::source_path("maps/robots/pioneer.json"));
-  graph::TopologicalMap map = graph::read_map(test::source_path("maps/office_floor.geojson")).map;
-  const CameraDescription& camera() const { return *robot.find_camera("ceiling_camera"); }
-};
+using World = test::OfficeWorld;
 
 LampShapePrior office_prior() {
   LampShapePrior p;  // 1.2 x 0.3 m lamps at 2.7 m, camera at 0.3 m

@@ -8,6 +8,7 @@
 #include "lampnav/sim/renderers.hpp"
 #include "lampnav/vision/lamp_tracker.hpp"
 #include "lampnav_test.hpp"
+#include "office_world.hpp"
 
 namespace lampnav::vision {
 namespace {
@@ -15,11 +16,7 @@ namespace {
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 
-struct Drive {
-  RobotDescription robot = read_robot_description(test::source_path("maps/robots/pioneer.json"));
-  graph::TopologicalMap map = graph::read_map(test::source_path("maps/office_floor.geojson")).map;
-  const CameraDescription& camera() const { return *robot.find_camera("ceiling_camera"); }
-};
+using World = test::OfficeWorld;
 
 // The lamp whose projected centre is nearest a detection: lamps are hundreds of pixels apart.
 std::string lamp_under(const sim::CeilingRenderer& r, const Pose2& pose,
@@ -39,7 +36,7 @@ std::string lamp_under(const sim::CeilingRenderer& r, const Pose2& pose,
 }
 
 TEST(LampTracker, OneTrackPerLampWhileInView) {
-  const Drive w;
+  const World w;
   const sim::CeilingRenderer renderer(w.camera(), {});
   LampTracker tracker(w.camera(), LampShapePrior{});
   const graph::Node& c1 = *w.map.find_node("C1");
@@ -78,7 +75,7 @@ TEST(LampTracker, OneTrackPerLampWhileInView) {
 }
 
 TEST(LampTracker, ResetEndsEveryTrackAndBadFramesLeaveTracksAlone) {
-  const Drive w;
+  const World w;
   const sim::CeilingRenderer renderer(w.camera(), {});
   LampTracker tracker(w.camera(), LampShapePrior{});
   std::mt19937_64 rng(8);

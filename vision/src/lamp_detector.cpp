@@ -6,6 +6,7 @@
 #include <cstring>
 #include <string>
 
+#include "lampnav/core/pose2.hpp"
 #include "lampnav/vision/camera_models.hpp"
 
 namespace lampnav::vision {
@@ -168,11 +169,6 @@ void open_mask(const std::vector<std::uint8_t>& in, int w, int h, int r,
   cols(tmp.data(), out.data(), true);  // eroded
   rows(out.data(), tmp.data(), false);
   cols(tmp.data(), out.data(), false);  // opened
-}
-
-double wrap_half_pi(double a) {
-  a = std::remainder(a, M_PI);  // (-pi/2, pi/2]
-  return a <= -M_PI / 2 ? a + M_PI : a;
 }
 
 }  // namespace
@@ -446,7 +442,7 @@ bool LampDetector::Impl::measure(const Component& c, const ImageView& g, LampDet
   const double root = std::sqrt(0.25 * (mu20 - mu02) * (mu20 - mu02) + mu11 * mu11);
   const double l1 = half_sum + root, l2 = std::max(0.0, half_sum - root);
   out.centre = Vector2d(cx, cy);
-  out.orientation = wrap_half_pi(0.5 * std::atan2(2 * mu11, mu20 - mu02));
+  out.orientation = wrap_axis_angle(0.5 * std::atan2(2 * mu11, mu20 - mu02));
   // Uniform rectangle: variance L^2 / 12 along a side; uniform disc: D^2 / 16 on any axis.
   const double k = prior.rectangle ? 12.0 : 16.0;
   out.length = std::sqrt(k * l1);
@@ -559,7 +555,7 @@ bool LampDetector::Impl::complete(const Component& c, const ImageView& g, int pa
   }
   if (!best.ok || best.rms / px > o.max_fit_rms_px) return false;
   out.centre = best.centre;
-  if (prior.rectangle) out.orientation = wrap_half_pi(best.orientation);
+  if (prior.rectangle) out.orientation = wrap_axis_angle(best.orientation);
   out.length = 2 * half_a;
   out.width = 2 * half_b;
   out.fit_points = best.points;

@@ -8,6 +8,8 @@ namespace lampnav {
 
 // Wraps an angle to (-pi, pi] (conventions.md: angles are wrapped to that interval).
 double wrap_angle(double a);
+// Wraps the angle of an undirected axis (a lamp's long side) to (-pi/2, pi/2].
+double wrap_axis_angle(double a);
 
 class Pose2 {
  public:
