@@ -161,7 +161,6 @@ vision::LampShapePrior shape_prior_for(const graph::TopologicalMap& map,
 }
 
 struct CeilingPipeline::Impl {
-  const graph::TopologicalMap* map;
   CameraDescription camera;
   CeilingPipelineOptions o;
   vision::LampTracker tracker;
@@ -171,8 +170,7 @@ struct CeilingPipeline::Impl {
 
   Impl(const graph::TopologicalMap& m, const CameraDescription& c,
        const CeilingPipelineOptions& opt)
-      : map(&m),
-        camera(c),
+      : camera(c),
         o(opt),
         tracker(c, shape_prior_for(m, c), opt.detector, opt.tracker),
         labeller(m, c, opt.labeller),

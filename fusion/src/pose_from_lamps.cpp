@@ -1,6 +1,5 @@
 #include "lampnav/fusion/pose_from_lamps.hpp"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Dense>
 #include <cmath>
 

@@ -62,7 +62,6 @@ ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Ve
                    double theta, double min_drop) {
   ShapeFit fit;
   std::vector<char> use(pts.size(), 1);
-  const int params = rectangle ? 3 : 2;
   double rms = 0;
   for (int it = 0; it < 20; ++it) {
     Eigen::Matrix3d JtJ = Eigen::Matrix3d::Zero();
@@ -110,11 +109,11 @@ ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Ve
     // The fit must see an end and a long side of a rectangle, or its position along the lamp
     // (or across it) is not determined.
     if (rectangle && (ends < 4 || sides < 8)) return fit;
-    Eigen::Vector3d step = Eigen::Vector3d::Zero();
-    const auto block = JtJ.topLeftCorner(params, params);
-    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(block);
-    if (eig.eigenvalues()(0) < 1e-9 * std::max(1.0, eig.eigenvalues()(params - 1))) return fit;
-    step.head(params) = -block.ldlt().solve(Jtr.head(params));
+    // A disc has no heading: pin it (unit information, zero gradient) and solve the same 3x3.
+    if (!rectangle) JtJ(2, 2) = 1.0;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(JtJ);
+    if (eig.eigenvalues()(0) < 1e-9 * std::max(1.0, eig.eigenvalues()(2))) return fit;
+    const Eigen::Vector3d step = -JtJ.ldlt().solve(Jtr);
     c += step.head<2>();
     theta += step(2);
     if (step.head<2>().norm() < 1e-6 && std::fabs(step(2)) < 1e-5 && it > 3) break;
@@ -225,10 +224,9 @@ struct LampDetector::Impl {
   // Scratch, reused frame to frame.
   std::vector<std::uint8_t> grey, binary;
   std::vector<Run> runs;
-  std::vector<int> sorted_runs, component_of_root;
+  std::vector<int> sorted_runs, component_of_root, comp_of_run;
   std::vector<Component> components;
   std::vector<std::uint8_t> mask, opened, scratch;
-  int mask_width = 0;
   EdgePoints edges;
 
   Impl(const CameraDescription& camera, const LampShapePrior& p, const LampDetectorOptions& opt)
@@ -316,7 +314,6 @@ void LampDetector::Impl::label(const ImageView& g) {
   // Components, and their runs grouped together (counting sort by component).
   components.clear();
   component_of_root.assign(runs.size(), -1);
-  std::vector<int>& comp_of_run = sorted_runs;
   comp_of_run.resize(runs.size());
   for (std::size_t i = 0; i < runs.size(); ++i) {
     const int r = find_root(runs, static_cast<int>(i));
@@ -340,12 +337,11 @@ void LampDetector::Impl::label(const ImageView& g) {
     offset += c.run_count;
     c.run_count = 0;
   }
-  std::vector<int> order(runs.size());
+  sorted_runs.resize(runs.size());
   for (std::size_t i = 0; i < runs.size(); ++i) {
     Component& c = components[comp_of_run[i]];
-    order[c.first_run + c.run_count++] = static_cast<int>(i);
+    sorted_runs[c.first_run + c.run_count++] = static_cast<int>(i);
   }
-  sorted_runs = std::move(order);
 }
 
 LampDetections LampDetector::Impl::detect(const ImageView& image) {
@@ -375,7 +371,6 @@ bool LampDetector::Impl::measure(const Component& c, const ImageView& g, LampDet
   // continued outwards so that the opening does not eat the cut edge.
   const int r = o.opening_radius, pad = 2 * r + 1;
   const int mw = c.u1 - c.u0 + 1 + 2 * pad, mh = c.v1 - c.v0 + 1 + 2 * pad;
-  mask_width = mw;
   mask.assign(static_cast<std::size_t>(mw) * mh, 0);
   auto mrow = [&](std::vector<std::uint8_t>& m, int y) {
     return m.data() + static_cast<std::size_t>(y) * mw;
@@ -494,7 +489,8 @@ bool LampDetector::Impl::complete(const Component& c, const ImageView& g, int pa
   const double level = o.threshold - 0.5;
   auto inside = [&](int u, int v) {
     if (u < c.u0 || u > c.u1 || v < c.v0 || v > c.v1) return false;
-    return opened[static_cast<std::size_t>(v - c.v0 + pad) * mask_width + (u - c.u0 + pad)] != 0;
+    const int mw = c.u1 - c.u0 + 1 + 2 * pad;  // the mask measure() opened
+    return opened[static_cast<std::size_t>(v - c.v0 + pad) * mw + (u - c.u0 + pad)] != 0;
   };
   auto grey_at = [&](int u, int v) {
     return static_cast<double>(g.data[static_cast<std::size_t>(v) * g.row_stride() + u]);
