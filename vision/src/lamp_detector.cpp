@@ -7,6 +7,7 @@
 #include <string>
 
 #include "lampnav/core/pose2.hpp"
+#include "blobs.hpp"
 #include "lampnav/vision/camera_models.hpp"
 
 namespace lampnav::vision {
@@ -18,26 +19,6 @@ namespace {
 void require(bool ok, const char* what, const char* field, const std::string& message) {
   if (!ok) throw InputError({"", what, field}, message);
 }
-
-// A horizontal run of above-threshold pixels; `parent` links runs of one component (union-find).
-struct Run {
-  int row, u0, u1;  // inclusive
-  int parent;
-};
-
-int find_root(std::vector<Run>& runs, int i) {
-  while (runs[i].parent != i) {
-    runs[i].parent = runs[runs[i].parent].parent;  // path halving
-    i = runs[i].parent;
-  }
-  return i;
-}
-
-struct Component {
-  int pixels = 0;
-  int u0 = 1 << 30, v0 = 1 << 30, u1 = -1, v1 = -1;
-  int first_run = 0, run_count = 0;  // into the runs sorted by component
-};
 
 struct Moments {
   double m0 = 0, mx = 0, my = 0, mxx = 0, mxy = 0, myy = 0;
@@ -222,10 +203,8 @@ struct LampDetector::Impl {
   double area_nominal, area_min, area_max;  // of a whole lamp, normalized units^2
   double min_pixels, max_pixels;            // pixel-count bounds that cannot drop a lamp
   // Scratch, reused frame to frame.
-  std::vector<std::uint8_t> grey, binary;
-  std::vector<Run> runs;
-  std::vector<int> sorted_runs, component_of_root, comp_of_run;
-  std::vector<Component> components;
+  std::vector<std::uint8_t> grey;
+  detail::BlobLabeller blobs;
   std::vector<std::uint8_t> mask, opened, scratch;
   EdgePoints edges;
 
@@ -262,95 +241,18 @@ struct LampDetector::Impl {
 
   std::size_t index(int u, int v) const { return static_cast<std::size_t>(v) * w + u; }
 
-  void label(const ImageView& g);
   LampDetections detect(const ImageView& image);
-  bool measure(const Component& c, const ImageView& g, LampDetection& out, DetectionStats& st);
-  bool complete(const Component& c, const ImageView& g, int pad, LampDetection& out);
+  bool measure(const detail::Blob& c, const ImageView& g, LampDetection& out, DetectionStats& st);
+  bool complete(const detail::Blob& c, const ImageView& g, int pad, LampDetection& out);
 };
-
-// Threshold (OpenCV, vectorized), then runs of lamp pixels per row joined into 8-connected
-// components by union-find: the ceiling is mostly dark, so the work follows the lamps' outlines.
-void LampDetector::Impl::label(const ImageView& g) {
-  binary.resize(static_cast<std::size_t>(w) * h);
-  const std::uint8_t t = static_cast<std::uint8_t>(o.threshold);
-  const int width = w;
-  for (int v = 0; v < h; ++v) {  // a plain loop the compiler vectorizes; no thread pool
-    const std::uint8_t* __restrict in = g.data + static_cast<std::size_t>(v) * g.row_stride();
-    std::uint8_t* __restrict out = binary.data() + index(0, v);
-    for (int u = 0; u < width; ++u) out[u] = in[u] >= t ? 1 : 0;
-  }
-  runs.clear();
-  int prev_begin = 0, prev_end = 0;
-  for (int v = 0; v < h; ++v) {
-    const std::uint8_t* b = binary.data() + index(0, v);
-    const int cur_begin = static_cast<int>(runs.size());
-    int u = 0;
-    while (u < w) {
-      while (u + 8 <= w) {  // skip dark ceiling eight pixels at a time
-        std::uint64_t word;
-        std::memcpy(&word, b + u, 8);
-        if (word != 0) break;
-        u += 8;
-      }
-      while (u < w && b[u] == 0) ++u;
-      if (u >= w) break;
-      const int start = u;
-      while (u < w && b[u] != 0) ++u;
-      const int id = static_cast<int>(runs.size());
-      runs.push_back({v, start, u - 1, id});
-    }
-    const int cur_end = static_cast<int>(runs.size());
-    int j0 = prev_begin;
-    for (int c = cur_begin; c < cur_end; ++c) {
-      while (j0 < prev_end && runs[j0].u1 < runs[c].u0 - 1) ++j0;
-      for (int j = j0; j < prev_end && runs[j].u0 <= runs[c].u1 + 1; ++j) {
-        const int ra = find_root(runs, j), rb = find_root(runs, c);
-        if (ra != rb) runs[std::max(ra, rb)].parent = std::min(ra, rb);
-      }
-    }
-    prev_begin = cur_begin;
-    prev_end = cur_end;
-  }
-  // Components, and their runs grouped together (counting sort by component).
-  components.clear();
-  component_of_root.assign(runs.size(), -1);
-  comp_of_run.resize(runs.size());
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    const int r = find_root(runs, static_cast<int>(i));
-    if (component_of_root[r] < 0) {
-      component_of_root[r] = static_cast<int>(components.size());
-      components.emplace_back();
-    }
-    Component& c = components[component_of_root[r]];
-    const Run& run = runs[i];
-    c.pixels += run.u1 - run.u0 + 1;
-    c.u0 = std::min(c.u0, run.u0);
-    c.u1 = std::max(c.u1, run.u1);
-    c.v0 = std::min(c.v0, run.row);
-    c.v1 = std::max(c.v1, run.row);
-    ++c.run_count;
-    comp_of_run[i] = component_of_root[r];
-  }
-  int offset = 0;
-  for (auto& c : components) {
-    c.first_run = offset;
-    offset += c.run_count;
-    c.run_count = 0;
-  }
-  sorted_runs.resize(runs.size());
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    Component& c = components[comp_of_run[i]];
-    sorted_runs[c.first_run + c.run_count++] = static_cast<int>(i);
-  }
-}
 
 LampDetections LampDetector::Impl::detect(const ImageView& image) {
   check_image(image, w, h, {"", "image", ""});
   const ImageView g = grey_view(image, grey);
-  label(g);
+  blobs.label(g, static_cast<std::uint8_t>(o.threshold));
   LampDetections out;
-  out.stats.blobs = static_cast<int>(components.size());
-  for (const Component& c : components) {
+  out.stats.blobs = static_cast<int>(blobs.blobs().size());
+  for (const detail::Blob& c : blobs.blobs()) {
     if (c.pixels < min_pixels) {
       ++out.stats.too_small;
       continue;
@@ -365,7 +267,7 @@ LampDetections LampDetector::Impl::detect(const ImageView& image) {
   return out;
 }
 
-bool LampDetector::Impl::measure(const Component& c, const ImageView& g, LampDetection& out,
+bool LampDetector::Impl::measure(const detail::Blob& c, const ImageView& g, LampDetection& out,
                                  DetectionStats& st) {
   // The component's mask with a margin; on sides where the lamp leaves the image the mask is
   // continued outwards so that the opening does not eat the cut edge.
@@ -376,7 +278,7 @@ bool LampDetector::Impl::measure(const Component& c, const ImageView& g, LampDet
     return m.data() + static_cast<std::size_t>(y) * mw;
   };
   for (int k = 0; k < c.run_count; ++k) {
-    const Run& run = runs[sorted_runs[c.first_run + k]];
+    const detail::Run& run = blobs.run(c.first_run + k);
     std::memset(mrow(mask, run.row - c.v0 + pad) + (run.u0 - c.u0 + pad), 1,
                 static_cast<std::size_t>(run.u1 - run.u0 + 1));
   }
@@ -483,7 +385,7 @@ bool LampDetector::Impl::measure(const Component& c, const ImageView& g, LampDet
 
 // Completion of a lamp cut by the image border (paper 2, Fig. 5): the visible edges, located to a
 // fraction of a pixel where the grey level crosses the threshold, are fitted with the known shape.
-bool LampDetector::Impl::complete(const Component& c, const ImageView& g, int pad,
+bool LampDetector::Impl::complete(const detail::Blob& c, const ImageView& g, int pad,
                                   LampDetection& out) {
   edges.clear();
   const double level = o.threshold - 0.5;

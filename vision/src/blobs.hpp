@@ -1,0 +1,45 @@
+#pragma once
+// Bright blobs of a grey image: threshold, runs of bright pixels per row joined into 8-connected
+// components by union-find. The ceiling (and the IR-filtered omni view) is mostly dark, so the
+// work follows the lamps' outlines. Private to lampnav::vision; shared by both lamp detectors.
+
+#include <cstdint>
+#include <vector>
+
+#include "lampnav/vision/image_view.hpp"
+
+namespace lampnav::vision::detail {
+
+// A horizontal run of bright pixels (columns u0..u1 inclusive) of one row.
+struct Run {
+  int row, u0, u1;
+  int parent;  // union-find link while labelling
+};
+
+struct Blob {
+  int pixels = 0;
+  int u0 = 1 << 30, v0 = 1 << 30, u1 = -1, v1 = -1;  // bounding box, inclusive
+  int first_run = 0, run_count = 0;                  // into BlobLabeller::blob_runs()
+};
+
+class BlobLabeller {
+ public:
+  // Labels the pixels >= `threshold` of an 8-bit grey image of width x height. The scratch is
+  // kept from call to call: no allocation once the sizes have settled.
+  void label(const ImageView& grey, std::uint8_t threshold);
+
+  const std::vector<Blob>& blobs() const { return blobs_; }
+  // The runs of blob b are run(b.first_run) .. run(b.first_run + b.run_count - 1).
+  const Run& run(int k) const { return runs_[sorted_[k]]; }
+  // 0/1 per pixel, row-major, of the last label() call.
+  const std::vector<std::uint8_t>& binary() const { return binary_; }
+
+ private:
+  int find_root(int i);
+  std::vector<std::uint8_t> binary_;
+  std::vector<Run> runs_;
+  std::vector<int> sorted_, blob_of_root_, blob_of_run_;
+  std::vector<Blob> blobs_;
+};
+
+}  // namespace lampnav::vision::detail
