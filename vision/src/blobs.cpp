@@ -15,6 +15,8 @@ int BlobLabeller::find_root(int i) {
 
 void BlobLabeller::label(const ImageView& g, std::uint8_t t) {
   const int w = g.width, h = g.height;
+  width_ = w;
+  height_ = h;
   binary_.resize(static_cast<std::size_t>(w) * h);
   for (int v = 0; v < h; ++v) {  // a plain loop the compiler vectorizes; no thread pool
     const std::uint8_t* __restrict in = g.data + static_cast<std::size_t>(v) * g.row_stride();
@@ -84,6 +86,16 @@ void BlobLabeller::label(const ImageView& g, std::uint8_t t) {
     Blob& c = blobs_[blob_of_run_[i]];
     sorted_[c.first_run + c.run_count++] = static_cast<int>(i);
   }
+}
+
+int BlobLabeller::perimeter(const Blob& b) const {
+  int n = 0;
+  for (int k = 0; k < b.run_count; ++k) {
+    const Run& r = run(b.first_run + k);
+    for (int u = r.u0; u <= r.u1; ++u)
+      if (u == r.u0 || u == r.u1 || !bright(u, r.row - 1) || !bright(u, r.row + 1)) ++n;
+  }
+  return n;
 }
 
 }  // namespace lampnav::vision::detail

@@ -31,11 +31,18 @@ class BlobLabeller {
   const std::vector<Blob>& blobs() const { return blobs_; }
   // The runs of blob b are run(b.first_run) .. run(b.first_run + b.run_count - 1).
   const Run& run(int k) const { return runs_[sorted_[k]]; }
-  // 0/1 per pixel, row-major, of the last label() call.
-  const std::vector<std::uint8_t>& binary() const { return binary_; }
+  // 0/1 per pixel, row-major, of the last label() call; 0 outside the image.
+  std::uint8_t bright(int u, int v) const {
+    return u < 0 || v < 0 || u >= width_ || v >= height_
+               ? 0
+               : binary_[static_cast<std::size_t>(v) * width_ + u];
+  }
+  // Blob pixels with a 4-neighbour that is dark or outside the image.
+  int perimeter(const Blob& b) const;
 
  private:
   int find_root(int i);
+  int width_ = 0, height_ = 0;
   std::vector<std::uint8_t> binary_;
   std::vector<Run> runs_;
   std::vector<int> sorted_, blob_of_root_, blob_of_run_;

@@ -1,0 +1,118 @@
+#include "lampnav/vision/omni_detector.hpp"
+
+#include <cmath>
+
+#include "blobs.hpp"
+#include "lampnav/core/error.hpp"
+#include "lampnav/vision/camera_models.hpp"
+
+namespace lampnav::vision {
+
+void OmniDetectorOptions::validate() const {
+  auto fail = [](const char* field, const char* msg) {
+    throw InputError({"", "omni detector options", field}, msg);
+  };
+  if (threshold < 1 || threshold > 255) fail("threshold", "must be 1 to 255");
+  if (bloom_threshold <= threshold || bloom_threshold > 255)
+    fail("bloom_threshold", "must be above threshold and at most 255");
+  if (min_pixels < 1) fail("min_pixels", "must be at least 1");
+  if (big_blob_pixels <= min_pixels) fail("big_blob_pixels", "must be above min_pixels");
+  if (max_blobs < 1) fail("max_blobs", "must be at least 1");
+  if (!(max_theta_deg > 0 && max_theta_deg <= 180)) fail("max_theta_deg", "must be 0 to 180");
+}
+
+struct OmniLampDetector::Impl {
+  FisheyeCamera model;
+  OmniDetectorOptions o;
+  std::vector<std::uint8_t> grey, crop;
+  detail::BlobLabeller first, second;
+
+  Impl(const CameraDescription& c, const OmniDetectorOptions& opt) : model(c), o(opt) {
+    o.validate();
+  }
+
+  // Fills `out` from blob b of `lab`, whose pixel (0, 0) is image pixel (du, dv). False when the
+  // blob is outside the usable view.
+  bool describe(const detail::BlobLabeller& lab, const detail::Blob& b, int du, int dv,
+                OmniBlob* out) const {
+    double su = 0, sv = 0;
+    for (int k = 0; k < b.run_count; ++k) {
+      const detail::Run& r = lab.run(b.first_run + k);
+      const double n = r.u1 - r.u0 + 1;
+      su += n * (r.u0 + r.u1) / 2.0;
+      sv += n * r.row;
+    }
+    out->pixels = b.pixels;
+    out->perimeter = lab.perimeter(b);
+    out->centroid_px = Eigen::Vector2d(su / b.pixels + du, sv / b.pixels + dv);
+    const auto& p = model.parameters();
+    const Eigen::Vector2d d(out->centroid_px.x() - p.u0, (out->centroid_px.y() - p.v0) / p.beta);
+    out->radius_px = d.norm();
+    out->azimuth = std::atan2(d.y(), d.x());
+    const auto ray = model.unproject(out->centroid_px);
+    if (!ray) return false;
+    out->ray = ray->normalized();
+    out->theta = std::atan2(out->ray.head<2>().norm(), out->ray.z());
+    return out->theta <= o.max_theta_deg * M_PI / 180;
+  }
+
+  void add(const detail::BlobLabeller& lab, const detail::Blob& b, int du, int dv, bool bloom,
+           OmniDetection* out) const {
+    if (b.pixels < o.min_pixels) {
+      ++out->too_small;
+      return;
+    }
+    OmniBlob blob;
+    blob.from_bloom = bloom;
+    if (!describe(lab, b, du, dv, &blob)) {
+      ++out->outside_view;
+      return;
+    }
+    out->blobs.push_back(blob);
+  }
+
+  OmniDetection detect(const ImageView& image) {
+    check_image(image, model.width(), model.height(), {"", "image", ""});
+    const ImageView g = grey_view(image, grey);
+    first.label(g, static_cast<std::uint8_t>(o.threshold));
+    OmniDetection out;
+    out.raw_blobs = static_cast<int>(first.blobs().size());
+    if (out.raw_blobs > o.max_blobs) {
+      out.flooded = true;
+      return out;
+    }
+    for (const detail::Blob& b : first.blobs()) {
+      if (b.pixels <= o.big_blob_pixels) {
+        add(first, b, 0, 0, false, &out);
+        continue;
+      }
+      // A bloom: label its bounding box again at the higher threshold (paper 1, Fig. 9).
+      const int w = b.u1 - b.u0 + 1, h = b.v1 - b.v0 + 1;
+      crop.resize(static_cast<std::size_t>(w) * h);
+      for (int v = 0; v < h; ++v)
+        for (int u = 0; u < w; ++u)
+          crop[static_cast<std::size_t>(v) * w + u] =
+              first.bright(b.u0 + u, b.v0 + v) ? g.data[(b.v0 + v) * g.row_stride() + b.u0 + u]
+                                               : 0;
+      second.label(ImageView{crop.data(), w, h, 1, 1, static_cast<std::size_t>(w)}, static_cast<std::uint8_t>(o.bloom_threshold));
+      if (second.blobs().empty()) {  // no saturated core: keep the blob as it was
+        add(first, b, 0, 0, false, &out);
+        continue;
+      }
+      ++out.split_blooms;
+      for (const detail::Blob& c : second.blobs()) add(second, c, b.u0, b.v0, true, &out);
+    }
+    return out;
+  }
+};
+
+OmniLampDetector::OmniLampDetector(const CameraDescription& camera,
+                                   const OmniDetectorOptions& options)
+    : impl_(std::make_unique<Impl>(camera, options)) {}
+OmniLampDetector::~OmniLampDetector() = default;
+OmniLampDetector::OmniLampDetector(OmniLampDetector&&) noexcept = default;
+OmniLampDetector& OmniLampDetector::operator=(OmniLampDetector&&) noexcept = default;
+OmniDetection OmniLampDetector::detect(const ImageView& image) { return impl_->detect(image); }
+const OmniDetectorOptions& OmniLampDetector::options() const { return impl_->o; }
+
+}  // namespace lampnav::vision
