@@ -6,7 +6,7 @@
 namespace lampnav::fusion {
 
 double chi_square_cdf(double x, int dof) {
-  if (dof < 1 || dof > 6) throw std::invalid_argument("chi_square_cdf: dof must be 1 to 6");
+  if (dof < 1 || dof > 200) throw std::invalid_argument("chi_square_cdf: dof must be 1 to 200");
   if (x <= 0) return 0.0;
   const double h = x / 2;
   // Even dof: 1 - e^-h sum_{k < dof/2} h^k / k!. Odd dof: erf(sqrt h) minus the series in

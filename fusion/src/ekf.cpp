@@ -230,24 +230,8 @@ UpdateResult PoseEkf::update(Stamp t, const Pose2& pose, const StateCovariance& 
   const StateCovariance Rs = 0.5 * (R + R.transpose());
   if (!correct(&post, z, Rs, &r.mahalanobis2)) return refused(Refusal::gated);
 
-  // Split the input entry spanning t (if any) exactly as state_at() did, insert the measurement
-  // after the part up to t, and re-run what follows.
-  auto it = std::upper_bound(history_.begin(), history_.end(), t,
-                             [](Stamp s, const Entry& e) { return s < e.state.stamp; });
-  std::size_t i = static_cast<std::size_t>(it - history_.begin());
-  if (i < history_.size() && history_[i - 1].state.stamp != t) {
-    Entry& later = history_[i];
-    const double f = static_cast<double>((t - history_[i - 1].state.stamp).count()) /
-                     static_cast<double>((later.state.stamp - history_[i - 1].state.stamp).count());
-    Entry first;
-    first.state = prior;
-    first.d_left = f * later.d_left;
-    first.d_right = f * later.d_right;
-    later.d_left -= first.d_left;
-    later.d_right -= first.d_right;
-    history_.insert(history_.begin() + static_cast<std::ptrdiff_t>(i), first);
-    ++i;
-  }
+  // Insert the measurement after the history's state at t, and re-run what follows.
+  const std::size_t i = split_at(t, prior) + 1;
   Entry m;
   m.state = post;
   m.measurement = true;
@@ -261,6 +245,51 @@ UpdateResult PoseEkf::update(Stamp t, const Pose2& pose, const StateCovariance& 
   ++applied_;
   if (r.reapplied_steps > 0) ++late_;
   return r;
+}
+
+std::size_t PoseEkf::split_at(Stamp t, const FilterState& at_t) {
+  auto it = std::upper_bound(history_.begin(), history_.end(), t,
+                             [](Stamp s, const Entry& e) { return s < e.state.stamp; });
+  const std::size_t i = static_cast<std::size_t>(it - history_.begin());
+  if (i == history_.size() || history_[i - 1].state.stamp == t) return i - 1;
+  // Split the input entry spanning t exactly as state_at() interpolates it.
+  Entry& later = history_[i];
+  const Stamp before = history_[i - 1].state.stamp;
+  const double f = static_cast<double>((t - before).count()) /
+                   static_cast<double>((later.state.stamp - before).count());
+  Entry first;
+  first.state = at_t;
+  first.d_left = f * later.d_left;
+  first.d_right = f * later.d_right;
+  later.d_left -= first.d_left;
+  later.d_right -= first.d_right;
+  history_.insert(history_.begin() + static_cast<std::ptrdiff_t>(i), first);
+  return i;
+}
+
+std::optional<Refusal> PoseEkf::restart_at(Stamp t, const Pose2& pose, const StateCovariance& P) {
+  if (!initialized()) return refuse(Refusal::not_initialized);
+  const StateVector x(pose.x(), pose.y(), wrap_angle(pose.yaw()));
+  if (!x.allFinite() || !P.allFinite()) return refuse(Refusal::non_finite);
+  if (!is_covariance(P)) return refuse(Refusal::bad_covariance);
+  const Stamp latest = history_.back().state.stamp;
+  if (t < history_.front().state.stamp || t < latest - o_.history) return refuse(Refusal::too_old);
+  if (t > latest + o_.history) return refuse(Refusal::too_new);
+  if (t >= latest) {
+    initialize(t, pose, P);
+    return std::nullopt;
+  }
+  const std::size_t i = split_at(t, *state_at(t));
+  history_.erase(history_.begin(), history_.begin() + static_cast<std::ptrdiff_t>(i));
+  // Measurements belonged to the estimate that was wrong: only the odometry is re-applied.
+  history_.erase(std::remove_if(history_.begin() + 1, history_.end(),
+                                [](const Entry& e) { return e.measurement; }),
+                 history_.end());
+  pending_.clear();
+  history_.front().state = FilterState{t, x, 0.5 * (P + P.transpose())};
+  history_.front().measurement = false;
+  rerun_from(1);
+  return std::nullopt;
 }
 
 void PoseEkf::trim() {

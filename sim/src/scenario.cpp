@@ -119,7 +119,7 @@ Scenario make_named_scenario(const std::string& name, const graph::TopologicalMa
     const graph::Node& c2 = need(map, "C2", name);
     const double half = path_length(s.waypoints) / s.max_speed / 2;
     s.kidnaps.push_back(
-        {half, Pose2(c2.axis ? c2.axis->point_at(0.6 * c2.axis->length()) : c2.point, M_PI)});
+        {half, Pose2(c2.axis ? c2.axis->point_at(0.55 * c2.axis->length()) : c2.point, M_PI)});
     return s;
   }
   if (name == "domus-global" || name == "domus-kidnap") {

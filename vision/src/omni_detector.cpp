@@ -53,6 +53,8 @@ struct OmniLampDetector::Impl {
     if (!ray) return false;
     out->ray = ray->normalized();
     out->theta = std::atan2(out->ray.head<2>().norm(), out->ray.z());
+    const double dr_dtheta = (model.radius(out->theta + 1e-3) - model.radius(out->theta)) / 1e-3;
+    out->angular_radius = std::sqrt(b.pixels / M_PI) / std::max(1.0, dr_dtheta);
     return out->theta <= o.max_theta_deg * M_PI / 180;
   }
 

@@ -95,6 +95,11 @@ class PoseEkf {
   // time; when that is after the latest odometry it waits for the reading that covers it.
   UpdateResult update(Stamp stamp, const Pose2& z, const StateCovariance& R);
 
+  // Restarts from a pose known at `stamp` (a relocalization captured then) and re-applies the
+  // odometry after it. Measurements in the history are dropped: they were labelled with the
+  // estimate being replaced. Refused like a measurement when outside the history.
+  std::optional<Refusal> restart_at(Stamp stamp, const Pose2& pose, const StateCovariance& P);
+
   // The estimate at the latest odometry.
   const FilterState& current() const { return history_.back().state; }
   Pose2 pose() const { return current().pose(); }
@@ -135,6 +140,9 @@ class PoseEkf {
   // Runs a gated update of `s` in place; returns the squared Mahalanobis distance and whether it
   // passed the gate.
   bool correct(FilterState* s, const StateVector& z, const StateCovariance& R, double* d2) const;
+  // Makes the history have an entry ending exactly at t (splitting the input spanning it, whose
+  // first part ends in `at_t`); returns its index.
+  std::size_t split_at(Stamp t, const FilterState& at_t);
   // Recomputes the entries from `index` on from the one before it (re-gating measurements).
   void rerun_from(std::size_t index);
   void trim();

@@ -33,6 +33,7 @@ struct OmniBlob {
   double azimuth = 0;    // rad, atan2 of (v - v0) / beta and (u - u0), as the fisheye's phi
   double theta = 0;      // rad off the optical axis
   Eigen::Vector3d ray = Eigen::Vector3d::UnitZ();  // unit direction in the camera frame
+  double angular_radius = 0;  // rad, the radius of a disc of its area, seen from the camera
   bool from_bloom = false;  // split out of a big blob by the second threshold
 };
 

@@ -1,0 +1,121 @@
+#pragma once
+// Is the estimate still the robot? After a kidnap the ceiling camera may simply find no map lamp
+// where it looks, so refused measurements are not enough. The monitor weighs four kinds of
+// evidence, each cheap and each counted:
+//  - lamps seen in full view where the map (through the estimate) predicts none,
+//  - map lamps the estimate puts well inside the view that are not seen,
+//  - a run of measurements that do not fit: the normalised innovations (NIS) of the last N
+//    measurements summed and tested against the chi-square quantile with 3N degrees of freedom,
+//  - a low-rate check of the omnidirectional view: the lamps the estimate predicts overhead
+//    against the blobs the omni camera sees.
+// Lamps fail and people hide lamps: a missing lamp alone never declares the robot lost.
+
+#include <Eigen/Core>
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "lampnav/core/robot_description.hpp"
+#include "lampnav/core/time.hpp"
+#include "lampnav/graph/map.hpp"
+#include "lampnav/vision/omni_detector.hpp"
+
+namespace lampnav::fusion {
+
+struct KidnapMonitorOptions {
+  int window_frames = 10;         // ceiling frames in the sliding window (1 s at 10 Hz)
+  int contradicting_frames = 4;   // frames with a contradiction in the window that mean lost
+  int missing_support_frames = 4; // frames with expected lamps missing that, with two
+                                  // contradicting frames, also mean lost
+  int nis_window = 8;             // measurements in the NIS window test
+  double nis_probability = 0.9999;  // its chi-square quantile (3 * nis_window dof)
+  int omni_failures = 2;          // consecutive inconsistent omni checks that mean lost
+  int omni_strong_expected = 4;   // a check with at least this many blobs ...
+  double omni_strong_fraction = 0.5;  // ... of which at most this fraction are explained (and
+                                      // as few predicted lamps seen) means lost at once
+  void validate() const;          // throws InputError naming the field
+};
+
+// What one ceiling frame says about the estimate it was labelled with.
+struct CeilingEvidence {
+  Stamp stamp;
+  int lamps_in_view = 0;     // detections in full (or completed) view
+  int labelled = 0;          // of those, with a map lamp
+  int unexplained = 0;       // in full view, and no map lamp inside the gate
+  int expected_missing = 0;  // map lamps the estimate puts well inside the view, nothing near
+  bool measurement_refused = false;  // its pose measurement failed the filter's gate
+  bool inconsistent = false;         // labelled lamps that do not agree with each other
+  bool contradicts() const { return unexplained > 0 || measurement_refused || inconsistent; }
+};
+
+struct OmniCheckOptions {
+  double max_theta_deg = 75;         // lamps and blobs used: at most this far off the axis
+  double detection_sigma_deg = 0.3;  // a blob centroid's direction
+  double tilt_sigma_deg = 0.6;       // floor bumps swing the camera
+  double max_position_sigma = 0.5;   // m; with more uncertainty the check says nothing
+  int min_expected = 3;              // fewer clear lamps predicted (and fewer blobs seen):
+                                     // inconclusive
+  double min_match_fraction = 0.5;   // below (for lamps, or for blobs): inconsistent
+  void validate() const;
+};
+
+struct OmniCheckResult {
+  bool conclusive = false;
+  bool consistent = true;
+  bool lamp_side = false, blob_side = false;  // enough predicted lamps / seen blobs to judge
+  int expected = 0;  // clear lamps the estimate predicts in the used part of the view
+  int matched = 0;   // of those, with a blob in the expected direction (one-to-one)
+  int blobs = 0;     // blobs in the used part of the view
+  int explained_blobs = 0;  // of those, in the direction of some map lamp
+  double match_fraction() const { return expected ? double(matched) / expected : 0.0; }
+  double explained_fraction() const { return blobs ? double(explained_blobs) / blobs : 1.0; }
+};
+
+// The omni view against an estimate: predicted lamp directions matched one-to-one to blob rays
+// within a tolerance from the detection noise, the floor bumps and the estimate's covariance.
+// Lamps whose directions crowd each other are left out (their blobs merge).
+class OmniCheck {
+ public:
+  OmniCheck(const graph::TopologicalMap& map, const CameraDescription& omni_camera,
+            const OmniCheckOptions& options = {});
+  OmniCheckResult check(const Pose2& pose, const Eigen::Matrix3d& covariance,
+                        const std::vector<vision::OmniBlob>& blobs) const;
+
+ private:
+  const graph::TopologicalMap* map_;
+  Eigen::Matrix3d mount_R_;
+  Eigen::Vector3d mount_t_;
+  OmniCheckOptions o_;
+  std::vector<const graph::Lamp*> lamps_;
+};
+
+class KidnapMonitor {
+ public:
+  explicit KidnapMonitor(const KidnapMonitorOptions& options = {});
+  // Each returns why the robot is lost, once the evidence says so.
+  std::optional<std::string> ceiling(const CeilingEvidence& evidence);
+  std::optional<std::string> innovation(double mahalanobis2);
+  std::optional<std::string> omni(const OmniCheckResult& result);
+  // Forgets the evidence (after relocalization).
+  void reset();
+
+  // Counters over the mission.
+  struct Counts {
+    std::uint64_t frames = 0, contradicting_frames = 0, unexplained_lamps = 0,
+                  missing_lamps = 0, refused_measurements = 0, nis_alarms = 0,
+                  omni_checks = 0, omni_inconsistent = 0, losses = 0;
+  };
+  const Counts& counts() const { return counts_; }
+
+ private:
+  KidnapMonitorOptions o_;
+  double nis_limit_;
+  std::deque<CeilingEvidence> window_;
+  std::deque<double> nis_;
+  double nis_sum_ = 0;
+  int omni_bad_ = 0;
+  Counts counts_;
+};
+
+}  // namespace lampnav::fusion

@@ -1,0 +1,351 @@
+// The localizer on simulated missions, read back from their logs and fed in arrival order:
+// accuracy on the corridor with the camera 1 s late (with and without half the frames dark),
+// kidnaps detected (latency measured from the first frame after the kidnap that shows a lamp),
+// no false alarm on kidnap-free runs, relocalization by a global fix.
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <random>
+
+#include "lampnav/core/error.hpp"
+#include "lampnav/fusion/localizer.hpp"
+#include "lampnav/graph/geojson.hpp"
+#include "lampnav/io/mission_log.hpp"
+#include "lampnav/sim/scenario.hpp"
+#include "lampnav_test.hpp"
+
+namespace lampnav::fusion {
+namespace {
+
+using Eigen::Matrix3d;
+using Eigen::Vector3d;
+
+Pose2 truth_at(const std::vector<io::Logged<io::TruthPose>>& truth, Stamp t) {
+  auto it = std::lower_bound(truth.begin(), truth.end(), t,
+                             [](const auto& a, Stamp s) { return a.value.stamp < s; });
+  if (it == truth.begin()) return it->value.pose;
+  if (it == truth.end()) return truth.back().value.pose;
+  const auto& b = it->value;
+  const auto& a = std::prev(it)->value;
+  // A kidnap is a jump between two truth samples: no interpolation across it.
+  if ((b.pose.translation() - a.pose.translation()).norm() > 0.5) return a.pose;
+  const double f = to_seconds(t - a.stamp) / std::max(1e-12, to_seconds(b.stamp - a.stamp));
+  return Pose2(a.pose.translation() + f * (b.pose.translation() - a.pose.translation()),
+               a.pose.yaw() + f * wrap_angle(b.pose.yaw() - a.pose.yaw()));
+}
+
+struct Kidnapped {
+  Stamp at;                   // lifted (log event)
+  std::optional<Stamp> shown; // capture of the first frame after it that shows a lamp
+  std::optional<Stamp> lost;  // when the localizer declared it lost
+  double latency() const { return to_seconds(*lost - *shown); }
+};
+
+struct Outcome {
+  int wheel_steps = 0, ceiling_frames = 0, dark_frames = 0, scored = 0;
+  double sum2_pos = 0, sum2_yaw = 0, max_pos = 0, max_yaw = 0;
+  std::vector<Kidnapped> kidnaps;
+  int false_alarms = 0, relocalizations = 0;
+  std::vector<std::pair<double, double>> p_norm;  // (s, |P|)
+  double rms_pos() const { return std::sqrt(sum2_pos / scored); }
+  double rms_yaw_deg() const { return std::sqrt(sum2_yaw / scored) * 180 / M_PI; }
+  std::string summary() const {
+    std::ostringstream s;
+    s << scored << " estimates scored, " << ceiling_frames << " ceiling frames (" << dark_frames
+      << " dark): position RMS " << rms_pos() * 100 << " cm (max " << max_pos * 100
+      << "), yaw RMS " << rms_yaw_deg() << " deg (max " << max_yaw * 180 / M_PI << "); "
+      << kidnaps.size() << " kidnaps, " << false_alarms << " false alarms";
+    for (const auto& k : kidnaps) {
+      s << "\n  kidnap at " << to_seconds(k.at) << " s: ";
+      if (!k.shown) s << "no lamp shown";
+      else if (!k.lost) s << "NOT DETECTED";
+      else s << "lamp shown at " << to_seconds(*k.shown) << " s, lost at " << to_seconds(*k.lost)
+             << " s, latency " << k.latency() << " s";
+    }
+    return s.str();
+  }
+};
+
+struct World {
+  std::string geojson;
+  graph::TopologicalMap map;
+  RobotDescription robot = read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  explicit World(const std::string& map_file)
+      : geojson(test::slurp(test::source_path(map_file))),
+        map(graph::parse_map(geojson, map_file).map) {}
+};
+
+io::MissionLog record(const sim::Scenario& s) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("lampnav_localizer_" + std::to_string(::getpid()) + ".mcap"))
+                               .string();
+  sim::record_mission(s, path);
+  io::MissionLog log = io::read_mission_log(path);
+  std::filesystem::remove(path);
+  return log;
+}
+
+// Feeds the log in arrival order, starting from the true pose. When the localizer is lost after an omni frame, that frame
+// gives a global fix: truth at its capture plus 3 cm / 1 degree of noise (the omnivision
+// localizer of issue 6 stands here).
+Outcome replay(const sim::Scenario& s, const io::MissionLog& log, const graph::TopologicalMap& map,
+           bool relocalize) {
+  Localizer loc(map, s.robot);
+  std::vector<io::Logged<io::TruthPose>> truth = log.truth;
+  auto by_stamp = [](const auto& a, const auto& b) { return a.value.stamp < b.value.stamp; };
+  std::sort(truth.begin(), truth.end(), by_stamp);
+  enum Kind { wheels, ceiling, omni };
+  struct Item {
+    Stamp arrival;
+    Kind kind;
+    std::size_t index;
+  };
+  std::vector<Item> items;
+  for (std::size_t i = 0; i < log.wheels.size(); ++i) items.push_back({log.wheels[i].log_time, wheels, i});
+  for (std::size_t i = 0; i < log.ceiling_images.size(); ++i)
+    items.push_back({log.ceiling_images[i].log_time, ceiling, i});
+  for (std::size_t i = 0; i < log.omni_images.size(); ++i)
+    items.push_back({log.omni_images[i].log_time, omni, i});
+  std::stable_sort(items.begin(), items.end(),
+                   [](const Item& a, const Item& b) { return a.arrival < b.arrival; });
+  Outcome run;
+  for (const auto& e : log.events)
+    if (e.value.kind == "kidnap") run.kidnaps.push_back({e.value.stamp, {}, {}});
+  std::mt19937 rng(17);
+  std::normal_distribution<double> n01;
+  // Scored only while the estimate should be right: tracking, and not between a kidnap and the
+  // relocalization that follows it.
+  bool unsure = false;
+  std::size_t next_kidnap = 0, events_seen = 1;
+  loc.initialize(log.wheels.front().value.stamp, truth_at(truth, log.wheels.front().value.stamp),
+                 Vector3d(1e-4, 1e-4, 3e-4).asDiagonal());
+  for (const Item& it : items) {
+    const Stamp now = it.arrival;
+    while (next_kidnap < run.kidnaps.size() && run.kidnaps[next_kidnap].at <= now) {
+      unsure = true;
+      ++next_kidnap;
+    }
+    if (it.kind == wheels) {
+      const auto& w = log.wheels[it.index].value;
+      loc.wheels(w.stamp, w.left, w.right);
+      ++run.wheel_steps;
+      const LocalizerEstimate e = loc.estimate();
+      if (!unsure && e.mode == LocalizerMode::tracking) {
+        const Pose2 t = truth_at(truth, e.stamp);
+        const double ep = (e.pose.translation() - t.translation()).norm();
+        const double ey = std::fabs(wrap_angle(e.pose.yaw() - t.yaw()));
+        ++run.scored;
+        run.sum2_pos += ep * ep;
+        run.sum2_yaw += ey * ey;
+        run.max_pos = std::max(run.max_pos, ep);
+        run.max_yaw = std::max(run.max_yaw, ey);
+      }
+      if (run.wheel_steps % 10 == 0)
+        run.p_norm.emplace_back(to_seconds(e.stamp), covariance_norm(e.covariance));
+    } else if (it.kind == ceiling) {
+      const auto& f = log.ceiling_images[it.index].value;
+      const Image8 img = io::decode_image(f.data, "frame");
+      const CeilingObservation& ob = loc.ceiling_frame(f.stamp, vision::ImageView::of(img));
+      ++run.ceiling_frames;
+      int full = 0;
+      for (const auto& l : ob.lamps) full += l.detection.view != vision::LampView::partial;
+      if (full == 0) ++run.dark_frames;
+      for (auto& k : run.kidnaps)
+        if (!k.shown && f.stamp >= k.at && !ob.lamps.empty()) k.shown = f.stamp;
+    } else {
+      const auto& f = log.omni_images[it.index].value;
+      const Image8 img = io::decode_image(f.data, "omni frame");
+      const vision::OmniDetection& d = loc.omni_frame(f.stamp, vision::ImageView::of(img));
+      for (auto& k : run.kidnaps)
+        if (!k.shown && f.stamp >= k.at && !d.blobs.empty()) k.shown = f.stamp;
+      if (relocalize && loc.mode() == LocalizerMode::lost) {
+        const Pose2 t = truth_at(truth, f.stamp);
+        GlobalFix fix{f.stamp,
+                      Pose2(t.x() + 0.03 * n01(rng), t.y() + 0.03 * n01(rng),
+                            t.yaw() + 0.017 * n01(rng)),
+                      Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.035 * 0.035).asDiagonal(), "truth"};
+        if (loc.global_fix(fix)) {
+          ++run.relocalizations;
+          unsure = false;
+        }
+      }
+    }
+    // New mode changes: a loss is the detection of the latest kidnap, or a false alarm.
+    for (; events_seen < loc.events().size(); ++events_seen) {
+      const LocalizerEvent& ev = loc.events()[events_seen];
+      if (ev.mode != LocalizerMode::lost) continue;
+      Kidnapped* k = nullptr;
+      for (auto& c : run.kidnaps)
+        if (c.at <= now && !c.lost) k = &c;
+      if (k) {
+        k->lost = now;
+        if (!k->shown) k->shown = now;  // lost before any lamp showed (dark place)
+      } else {
+        ++run.false_alarms;
+        std::cout << "false alarm at " << to_seconds(now) << " s: " << ev.reason << "\n";
+      }
+    }
+  }
+  std::cout << "odometry calibration: " << loc.calibration().pairs() << " pairs, drift "
+            << loc.calibration().yaw_drift_per_m() * 180 / M_PI << " deg/m, turn scale "
+            << loc.calibration().turn_scale() << "\n";
+  return run;
+}
+
+sim::Scenario corridor(const World& w, std::uint64_t seed) {
+  sim::Scenario s = sim::make_named_scenario("corridor", w.map, w.geojson, w.robot, seed);
+  s.ceiling_delay_s = 1.0;
+  return s;
+}
+
+TEST(Localizer, CorridorWithTheCameraOneSecondLate) {
+  const World w("maps/office_floor.geojson");
+  const sim::Scenario s = corridor(w, 21);
+  const io::MissionLog log = record(s);
+  const Outcome r = replay(s, log, w.map, false);
+  std::cout << r.summary() << "\n";
+  EXPECT_LE(r.rms_pos(), 0.03);
+  EXPECT_LE(r.rms_yaw_deg(), 0.5);
+  EXPECT_LE(r.max_pos, 0.15);  // never diverging
+  EXPECT_EQ(r.false_alarms, 0);
+  EXPECT_GT(r.scored, r.wheel_steps * 95 / 100);
+}
+
+// Two lamps of every three failed along C1 and C2: more than half the frames are dark, in runs
+// of about 3 m. Position holds; heading is dead reckoning over the dark runs, and the simulated
+// wheels' random error alone (0.002 m per sqrt(m) per wheel) is 0.7 degrees of heading after
+// 3.2 m: the 0.5-degree target is not met here (docs/localization.md).
+TEST(Localizer, CorridorWithHalfTheFramesDark) {
+  const World w("maps/office_floor.geojson");
+  sim::Scenario s = corridor(w, 22);
+  s.failed_lamps = {"C1-L2", "C1-L3", "C1-L5", "C1-L6", "C1-L8",
+                    "C2-L1", "C2-L2", "C2-L4", "C2-L5", "C2-L7", "C2-L8"};
+  const io::MissionLog log = record(s);
+  const Outcome r = replay(s, log, w.map, false);
+  std::cout << r.summary() << "\n";
+  EXPECT_GE(r.dark_frames * 2, r.ceiling_frames);
+  EXPECT_LE(r.rms_pos(), 0.03);
+  EXPECT_LE(r.rms_yaw_deg(), 0.9);
+  EXPECT_LE(r.max_pos, 0.15);
+  EXPECT_EQ(r.false_alarms, 0);
+}
+
+TEST(Localizer, OfficeMissionKidnapDetectedAndRelocalized) {
+  const World w("maps/office_floor.geojson");
+  const sim::Scenario s = sim::make_named_scenario("office-mission", w.map, w.geojson, w.robot, 1);
+  const io::MissionLog log = record(s);
+  const Outcome r = replay(s, log, w.map, true);
+  std::cout << r.summary() << "\n";
+  ASSERT_EQ(r.kidnaps.size(), 1u);
+  ASSERT_TRUE(r.kidnaps[0].lost);
+  EXPECT_LE(r.kidnaps[0].latency(), 2.0);
+  EXPECT_EQ(r.false_alarms, 0);
+  EXPECT_GE(r.relocalizations, 1);
+  EXPECT_LE(r.rms_pos(), 0.05);
+}
+
+// The same mission put down 2 m further along C2, where the view aliases the one the estimate
+// expects: same corridor lamps at the same place in the image, heading along the corridor. No
+// sensor can tell until the corridors differ; the loss is found late, but found.
+TEST(Localizer, AliasedKidnapIsFoundWhenTheCorridorsDiffer) {
+  const World w("maps/office_floor.geojson");
+  sim::Scenario s = sim::make_named_scenario("office-mission", w.map, w.geojson, w.robot, 1);
+  const graph::Node& c2 = *w.map.find_node("C2");
+  s.kidnaps[0].to = Pose2(c2.axis->point_at(0.6 * c2.axis->length()), M_PI);
+  const io::MissionLog log = record(s);
+  const Outcome r = replay(s, log, w.map, true);
+  std::cout << r.summary() << "\n";
+  ASSERT_EQ(r.kidnaps.size(), 1u);
+  ASSERT_TRUE(r.kidnaps[0].lost);
+  EXPECT_EQ(r.false_alarms, 0);
+  EXPECT_GE(r.relocalizations, 1);
+}
+
+// Paper 1's runs, omnidirectional camera only: the kidnap-free run raises no alarm; in the
+// carried run every jump is a kidnap and each is found by the omni check.
+TEST(Localizer, DomusGlobalRunRaisesNoAlarm) {
+  const World w("maps/domus_museum.geojson");
+  const sim::Scenario s = sim::make_named_scenario("domus-global", w.map, w.geojson, w.robot, 1);
+  const io::MissionLog log = record(s);
+  const Outcome r = replay(s, log, w.map, false);
+  std::cout << r.summary() << "\n";
+  // No camera corrects the estimate here (the omni global localizer is issue 6): its covariance
+  // grows with the drift, and the omni check stays silent rather than crying wolf.
+  EXPECT_EQ(r.false_alarms, 0);
+}
+
+TEST(Localizer, DomusKidnapEveryJumpDetected) {
+  const World w("maps/domus_museum.geojson");
+  const sim::Scenario s = sim::make_named_scenario("domus-kidnap", w.map, w.geojson, w.robot, 1);
+  const io::MissionLog log = record(s);
+  const Outcome r = replay(s, log, w.map, true);
+  std::cout << r.summary() << "\n";
+  EXPECT_GE(r.kidnaps.size(), 10u);
+  int detected = 0;
+  double worst = 0;
+  for (const auto& k : r.kidnaps) {
+    if (!k.lost || !k.shown) continue;
+    ++detected;
+    worst = std::max(worst, k.latency());
+  }
+  std::cout << detected << " of " << r.kidnaps.size() << " jumps detected, worst latency "
+            << worst << " s\n";
+  // One jump lands where half the predicted lamps happen to be seen: it takes a second frame.
+  EXPECT_GE(detected, static_cast<int>(r.kidnaps.size()) - 1);
+  EXPECT_LE(worst, 2.0);
+  EXPECT_EQ(r.false_alarms, 0);
+}
+
+}  // namespace
+}  // namespace lampnav::fusion
+
+namespace lampnav::fusion {
+namespace {
+
+TEST(Localizer, RefusesBadInputAndStaysHealthy) {
+  const World w("maps/office_floor.geojson");
+  Localizer loc(w.map, w.robot);
+  const Matrix3d P0 = Vector3d(1e-4, 1e-4, 1e-4).asDiagonal();
+  loc.initialize(stamp_from_seconds(0), Pose2(1, 10, 0), P0);
+  ASSERT_FALSE(loc.wheels(stamp_from_seconds(0), 0, 0));
+  ASSERT_FALSE(loc.wheels(stamp_from_seconds(0.02), 0.01, 0.01));
+  const LocalizerEstimate before = loc.estimate();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(loc.wheels(stamp_from_seconds(0.04), nan, 0.02), Refusal::non_finite);
+  EXPECT_EQ(loc.wheels(stamp_from_seconds(0.01), 0.02, 0.02), Refusal::time_backwards);
+  // An encoder that jumps by 50 m: refused, and the next readings count from the new value.
+  EXPECT_EQ(loc.wheels(stamp_from_seconds(0.04), 50.02, 0.02), Refusal::wheel_jump);
+  EXPECT_EQ(loc.counts().wheel_rebaselined, 1u);
+  EXPECT_EQ(loc.estimate().pose.x(), before.pose.x());
+  EXPECT_FALSE(loc.wheels(stamp_from_seconds(0.06), 50.03, 0.03));
+  EXPECT_NEAR(loc.estimate().pose.x(), before.pose.x() + 0.01, 1e-3);
+  // A frame that is not an image of the camera: InputError, nothing else changes.
+  Image8 small;
+  small.width = 10;
+  small.height = 10;
+  small.pixels.assign(100, 0);
+  EXPECT_THROW(loc.ceiling_frame(stamp_from_seconds(0.05), vision::ImageView::of(small)),
+               InputError);
+  EXPECT_THROW(loc.omni_frame(stamp_from_seconds(0.05), vision::ImageView::of(small)), InputError);
+  EXPECT_EQ(loc.mode(), LocalizerMode::tracking);
+  // Fixes that are not finite, or older than the history, are refused and counted.
+  EXPECT_FALSE(loc.global_fix({stamp_from_seconds(0.05), Pose2(nan, 0, 0), P0, "test"}));
+  EXPECT_FALSE(loc.global_fix({stamp_from_seconds(-10), Pose2(1, 10, 0), P0, "test"}));
+  EXPECT_EQ(loc.counts().fixes_refused, 2u);
+  EXPECT_TRUE(is_covariance(loc.estimate().covariance));
+  // A good fix re-initializes at its capture time and re-applies the odometry since.
+  EXPECT_TRUE(loc.global_fix({stamp_from_seconds(0.04), Pose2(5, 10, 0), P0, "test"}));
+  EXPECT_EQ(loc.mode(), LocalizerMode::relocalized);
+  EXPECT_NEAR(loc.estimate().pose.x(), 5.005, 1e-6);  // half of the 0.02 s -> 0.06 s step
+  ASSERT_NE(loc.estimate().node, nullptr);
+  // Robots without an omni camera simply have no omni input.
+  RobotDescription ceiling_only = w.robot;
+  ceiling_only.cameras.erase(ceiling_only.cameras.begin() + 1);
+  const Localizer c(w.map, ceiling_only);
+  EXPECT_TRUE(c.has_ceiling_camera());
+  EXPECT_FALSE(c.has_omni_camera());
+}
+
+}  // namespace
+}  // namespace lampnav::fusion
