@@ -36,8 +36,8 @@ void BM_EkfPredictAndGatedUpdate(benchmark::State& state) {
   for (auto _ : state) {
     t += 10;
     f.predict(at_ms(t), 0.005, 0.0052);
-    benchmark::DoNotOptimize(f.update(at_ms(t), Pose2(f.pose().x() + 0.001, f.pose().y(),
-                                                      f.pose().yaw()), kR));
+    benchmark::DoNotOptimize(
+        f.update(at_ms(t), Pose2(f.pose().x() + 0.001, f.pose().y(), f.pose().yaw()), kR));
   }
 }
 BENCHMARK(BM_EkfPredictAndGatedUpdate);

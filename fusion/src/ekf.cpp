@@ -31,15 +31,24 @@ void EkfOptions::validate() const {
 
 const char* to_string(Refusal r) {
   switch (r) {
-    case Refusal::not_initialized: return "not initialized";
-    case Refusal::non_finite: return "not finite";
-    case Refusal::time_backwards: return "time going backwards";
-    case Refusal::wheel_jump: return "absurd wheel jump";
-    case Refusal::bad_covariance: return "covariance not positive-definite";
-    case Refusal::gated: return "outside the validation gate";
-    case Refusal::too_old: return "older than the history";
-    case Refusal::too_new: return "too far after the latest odometry";
-    case Refusal::duplicate: return "duplicate";
+    case Refusal::not_initialized:
+      return "not initialized";
+    case Refusal::non_finite:
+      return "not finite";
+    case Refusal::time_backwards:
+      return "time going backwards";
+    case Refusal::wheel_jump:
+      return "absurd wheel jump";
+    case Refusal::bad_covariance:
+      return "covariance not positive-definite";
+    case Refusal::gated:
+      return "outside the validation gate";
+    case Refusal::too_old:
+      return "older than the history";
+    case Refusal::too_new:
+      return "too far after the latest odometry";
+    case Refusal::duplicate:
+      return "duplicate";
   }
   return "?";
 }
@@ -99,8 +108,7 @@ void PoseEkf::initialize(Stamp stamp, const Pose2& pose, const StateCovariance& 
   if (!std::isfinite(pose.x()) || !std::isfinite(pose.y()) || !std::isfinite(pose.yaw()))
     throw InputError({"", "initial pose", ""}, "is not finite");
   if (!is_covariance(P))
-    throw InputError({"", "initial pose", "covariance"},
-                     "is not symmetric positive-definite");
+    throw InputError({"", "initial pose", "covariance"}, "is not symmetric positive-definite");
   history_.clear();
   pending_.clear();
   Entry e;
@@ -210,8 +218,7 @@ UpdateResult PoseEkf::update(Stamp t, const Pose2& pose, const StateCovariance& 
   if (!z.allFinite() || !R.allFinite()) return refused(Refusal::non_finite);
   if (!is_covariance(R)) return refused(Refusal::bad_covariance);
   const Stamp latest = history_.back().state.stamp;
-  if (t < history_.front().state.stamp || t < latest - o_.history)
-    return refused(Refusal::too_old);
+  if (t < history_.front().state.stamp || t < latest - o_.history) return refused(Refusal::too_old);
   if (t > latest + o_.history) return refused(Refusal::too_new);
   if (known_measurement(t)) return refused(Refusal::duplicate);
   if (t > latest) {

@@ -113,7 +113,8 @@ OmniCheckResult OmniCheck::check(const Pose2& pose, const Eigen::Matrix3d& P,
       // A big blob (a near lamp's bloom, lamps merged) has its centroid anywhere inside it.
       if (a <= clear[i].tolerance + used[j]->angular_radius) pairs.push_back({a, i, j});
     }
-  std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) { return a.angle < b.angle; });
+  std::sort(pairs.begin(), pairs.end(),
+            [](const Pair& a, const Pair& b) { return a.angle < b.angle; });
   std::vector<char> p_used(clear.size(), 0), b_used(used.size(), 0);
   for (const Pair& q : pairs) {
     if (p_used[q.p] || b_used[q.b]) continue;
@@ -190,8 +191,8 @@ std::optional<std::string> KidnapMonitor::innovation(double d2) {
   ++counts_.nis_alarms;
   ++counts_.losses;
   const std::string why = "the last " + std::to_string(o_.nis_window) +
-                          " measurements do not fit (NIS sum " + std::to_string(nis_sum_) +
-                          " > " + std::to_string(nis_limit_) + ")";
+                          " measurements do not fit (NIS sum " + std::to_string(nis_sum_) + " > " +
+                          std::to_string(nis_limit_) + ")";
   reset();
   return why;
 }

@@ -9,9 +9,12 @@ namespace lampnav::fusion {
 
 const char* to_string(LocalizerMode m) {
   switch (m) {
-    case LocalizerMode::tracking: return "tracking";
-    case LocalizerMode::lost: return "lost";
-    case LocalizerMode::relocalized: return "relocalized";
+    case LocalizerMode::tracking:
+      return "tracking";
+    case LocalizerMode::lost:
+      return "lost";
+    case LocalizerMode::relocalized:
+      return "relocalized";
   }
   return "?";
 }
@@ -48,7 +51,11 @@ struct Localizer::Impl {
   LocalizerCounts counts;
 
   Impl(const graph::TopologicalMap& m, const RobotDescription& robot, LocalizerOptions opt)
-      : map(&m), o(fix_semi_axis(std::move(opt), robot)), ekf(o.ekf), calibration(o.calibration), monitor(o.kidnap) {
+      : map(&m),
+        o(fix_semi_axis(std::move(opt), robot)),
+        ekf(o.ekf),
+        calibration(o.calibration),
+        monitor(o.kidnap) {
     o.validate();
     if (const CameraDescription* c = robot.find_camera("ceiling_camera")) {
       pipeline.emplace(m, *c, o.ceiling);
@@ -136,7 +143,8 @@ struct Localizer::Impl {
           calibration.heading(ob.measurement->stamp, ob.measurement->pose.yaw(),
                               ob.measurement->covariance(2, 2));
         if (mode == LocalizerMode::relocalized && r.applied())
-          set_mode(LocalizerMode::tracking, "a ceiling measurement agrees with the relocalized pose");
+          set_mode(LocalizerMode::tracking,
+                   "a ceiling measurement agrees with the relocalized pose");
       } else {
         ++counts.measurements_refused;
       }
@@ -200,7 +208,8 @@ const CeilingObservation& Localizer::ceiling_frame(Stamp stamp, const vision::Im
   Impl& m = *impl_;
   m.last_ceiling = CeilingObservation{};
   m.last_ceiling.stamp = stamp;
-  if (!m.pipeline) throw InputError({"", "robot.json", "cameras"}, "the robot has no ceiling_camera");
+  if (!m.pipeline)
+    throw InputError({"", "robot.json", "cameras"}, "the robot has no ceiling_camera");
   const std::optional<FilterState> prior = prior_at(stamp);
   if (!prior) {
     ++m.counts.frames_too_old;
@@ -237,7 +246,8 @@ const vision::OmniDetection& Localizer::omni_frame(Stamp stamp, const vision::Im
   m.last_omni_check = stamp;
   const OmniCheckResult r = m.omni_check->check(prior->pose(), prior->P, m.last_omni.blobs);
   if (m.mode == LocalizerMode::relocalized && r.conclusive && r.consistent)
-    m.set_mode(LocalizerMode::tracking, "the omnidirectional view agrees with the relocalized pose");
+    m.set_mode(LocalizerMode::tracking,
+               "the omnidirectional view agrees with the relocalized pose");
   m.lose(m.monitor.omni(r));
   return m.last_omni;
 }

@@ -20,8 +20,7 @@ void OdometryCalibrationOptions::validate() const {
   if (!(max_drift > 0 && max_scale > 0)) fail("max_drift", "limits must be positive");
 }
 
-OdometryCalibration::OdometryCalibration(const OdometryCalibrationOptions& options)
-    : o_(options) {
+OdometryCalibration::OdometryCalibration(const OdometryCalibrationOptions& options) : o_(options) {
   o_.validate();
 }
 
@@ -87,7 +86,8 @@ void OdometryCalibration::heading(Stamp t, double yaw, double variance) {
     b1_ = l * b1_ + w * ds * residual;
     b2_ = l * b2_ + w * dr * residual;
     ++pairs_;
-    const double p1 = 1 / (o_.prior_drift * o_.prior_drift), p2 = 1 / (o_.prior_scale * o_.prior_scale);
+    const double p1 = 1 / (o_.prior_drift * o_.prior_drift),
+                 p2 = 1 / (o_.prior_scale * o_.prior_scale);
     const double m11 = a11_ + p1, m22 = a22_ + p2, det = m11 * m22 - a12_ * a12_;
     if (det > 0) {
       drift_ = std::clamp((m22 * b1_ - a12_ * b2_) / det, -o_.max_drift, o_.max_drift);

@@ -181,8 +181,7 @@ TEST(Ekf, LateMeasurementEqualsOnTimeResult) {
   using std::chrono::milliseconds;
   const PoseEkf on_time = run(d, m, {milliseconds(0), milliseconds(0), milliseconds(0)});
   // The camera is 1 s late, and the measurements arrive out of order.
-  const PoseEkf late =
-      run(d, m, {milliseconds(1000), milliseconds(1400), milliseconds(700)});
+  const PoseEkf late = run(d, m, {milliseconds(1000), milliseconds(1400), milliseconds(700)});
   // Captured after the latest odometry: held until the reading that covers it.
   const PoseEkf early = run(d, m, {milliseconds(-1), milliseconds(-1), milliseconds(-1)});
   EXPECT_EQ(on_time.updates_applied(), 3u);
@@ -193,7 +192,8 @@ TEST(Ekf, LateMeasurementEqualsOnTimeResult) {
     EXPECT_LT((f->covariance() - on_time.covariance()).cwiseAbs().maxCoeff(), 1e-9);
     for (double s : {1.0, 1.2345, 2.2, 4.5}) {
       if (stamp_from_seconds(s) < f->oldest()) continue;
-      const auto a = f->state_at(stamp_from_seconds(s)), b = on_time.state_at(stamp_from_seconds(s));
+      const auto a = f->state_at(stamp_from_seconds(s)),
+                 b = on_time.state_at(stamp_from_seconds(s));
       ASSERT_TRUE(a && b);
       EXPECT_LT((a->x - b->x).cwiseAbs().maxCoeff(), 1e-9) << s;
     }
@@ -277,12 +277,15 @@ TEST(Ekf, RefusesBadInputAndStaysHealthy) {
 TEST(Ekf, CovarianceStaysSymmetricPositiveDefinite) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(0, 1);
-  auto logu = [&](double lo, double hi) { return std::exp(std::log(lo) + u(rng) * std::log(hi / lo)); };
+  auto logu = [&](double lo, double hi) {
+    return std::exp(std::log(lo) + u(rng) * std::log(hi / lo));
+  };
   int updates = 0, checks = 0;
   for (int seq = 0; seq < 3000; ++seq) {
     PoseEkf f;
     const double p0 = logu(1e-8, 1e2);
-    f.initialize(ms(0), Pose2(10 * u(rng), 10 * u(rng), 6 * u(rng) - 3), diag(p0, p0 * u(rng) + 1e-9, logu(1e-9, 1)));
+    f.initialize(ms(0), Pose2(10 * u(rng), 10 * u(rng), 6 * u(rng) - 3),
+                 diag(p0, p0 * u(rng) + 1e-9, logu(1e-9, 1)));
     Stamp t = ms(0);
     for (int k = 0; k < 60; ++k) {
       const double r = u(rng);

@@ -36,9 +36,9 @@ Pose2 truth_at(const std::vector<io::Logged<io::TruthPose>>& truth, Stamp t) {
 }
 
 struct Kidnapped {
-  Stamp at;                   // lifted (log event)
-  std::optional<Stamp> shown; // capture of the first frame after it that shows a lamp
-  std::optional<Stamp> lost;  // when the localizer declared it lost
+  Stamp at;                    // lifted (log event)
+  std::optional<Stamp> shown;  // capture of the first frame after it that shows a lamp
+  std::optional<Stamp> lost;   // when the localizer declared it lost
   double latency() const { return to_seconds(*lost - *shown); }
 };
 
@@ -53,15 +53,18 @@ struct Outcome {
   std::string summary() const {
     std::ostringstream s;
     s << scored << " estimates scored, " << ceiling_frames << " ceiling frames (" << dark_frames
-      << " dark): position RMS " << rms_pos() * 100 << " cm (max " << max_pos * 100
-      << "), yaw RMS " << rms_yaw_deg() << " deg (max " << max_yaw * 180 / M_PI << "); "
-      << kidnaps.size() << " kidnaps, " << false_alarms << " false alarms";
+      << " dark): position RMS " << rms_pos() * 100 << " cm (max " << max_pos * 100 << "), yaw RMS "
+      << rms_yaw_deg() << " deg (max " << max_yaw * 180 / M_PI << "); " << kidnaps.size()
+      << " kidnaps, " << false_alarms << " false alarms";
     for (const auto& k : kidnaps) {
       s << "\n  kidnap at " << to_seconds(k.at) << " s: ";
-      if (!k.shown) s << "no lamp shown";
-      else if (!k.lost) s << "NOT DETECTED";
-      else s << "lamp shown at " << to_seconds(*k.shown) << " s, lost at " << to_seconds(*k.lost)
-             << " s, latency " << k.latency() << " s";
+      if (!k.shown)
+        s << "no lamp shown";
+      else if (!k.lost)
+        s << "NOT DETECTED";
+      else
+        s << "lamp shown at " << to_seconds(*k.shown) << " s, lost at " << to_seconds(*k.lost)
+          << " s, latency " << k.latency() << " s";
     }
     return s.str();
   }
@@ -86,11 +89,11 @@ io::MissionLog record(const sim::Scenario& s) {
   return log;
 }
 
-// Feeds the log in arrival order, starting from the true pose. When the localizer is lost after an omni frame, that frame
-// gives a global fix: truth at its capture plus 3 cm / 1 degree of noise (the omnivision
-// localizer of issue 6 stands here).
+// Feeds the log in arrival order, starting from the true pose. When the localizer is lost after an
+// omni frame, that frame gives a global fix: truth at its capture plus 3 cm / 1 degree of noise
+// (the omnivision localizer of issue 6 stands here).
 Outcome replay(const sim::Scenario& s, const io::MissionLog& log, const graph::TopologicalMap& map,
-           bool relocalize) {
+               bool relocalize) {
   Localizer loc(map, s.robot);
   std::vector<io::Logged<io::TruthPose>> truth = log.truth;
   auto by_stamp = [](const auto& a, const auto& b) { return a.value.stamp < b.value.stamp; };
@@ -102,7 +105,8 @@ Outcome replay(const sim::Scenario& s, const io::MissionLog& log, const graph::T
     std::size_t index;
   };
   std::vector<Item> items;
-  for (std::size_t i = 0; i < log.wheels.size(); ++i) items.push_back({log.wheels[i].log_time, wheels, i});
+  for (std::size_t i = 0; i < log.wheels.size(); ++i)
+    items.push_back({log.wheels[i].log_time, wheels, i});
   for (std::size_t i = 0; i < log.ceiling_images.size(); ++i)
     items.push_back({log.ceiling_images[i].log_time, ceiling, i});
   for (std::size_t i = 0; i < log.omni_images.size(); ++i)
@@ -161,10 +165,10 @@ Outcome replay(const sim::Scenario& s, const io::MissionLog& log, const graph::T
         if (!k.shown && f.stamp >= k.at && !d.blobs.empty()) k.shown = f.stamp;
       if (relocalize && loc.mode() == LocalizerMode::lost) {
         const Pose2 t = truth_at(truth, f.stamp);
-        GlobalFix fix{f.stamp,
-                      Pose2(t.x() + 0.03 * n01(rng), t.y() + 0.03 * n01(rng),
-                            t.yaw() + 0.017 * n01(rng)),
-                      Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.035 * 0.035).asDiagonal(), "truth"};
+        GlobalFix fix{
+            f.stamp,
+            Pose2(t.x() + 0.03 * n01(rng), t.y() + 0.03 * n01(rng), t.yaw() + 0.017 * n01(rng)),
+            Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.035 * 0.035).asDiagonal(), "truth"};
         if (loc.global_fix(fix)) {
           ++run.relocalizations;
           unsure = false;
@@ -219,8 +223,8 @@ TEST(Localizer, CorridorWithTheCameraOneSecondLate) {
 TEST(Localizer, CorridorWithHalfTheFramesDark) {
   const World w("maps/office_floor.geojson");
   sim::Scenario s = corridor(w, 22);
-  s.failed_lamps = {"C1-L2", "C1-L3", "C1-L5", "C1-L6", "C1-L8",
-                    "C2-L1", "C2-L2", "C2-L4", "C2-L5", "C2-L7", "C2-L8"};
+  s.failed_lamps = {"C1-L2", "C1-L3", "C1-L5", "C1-L6", "C1-L8", "C2-L1",
+                    "C2-L2", "C2-L4", "C2-L5", "C2-L7", "C2-L8"};
   const io::MissionLog log = record(s);
   const Outcome r = replay(s, log, w.map, false);
   std::cout << r.summary() << "\n";
@@ -289,8 +293,8 @@ TEST(Localizer, DomusKidnapEveryJumpDetected) {
     ++detected;
     worst = std::max(worst, k.latency());
   }
-  std::cout << detected << " of " << r.kidnaps.size() << " jumps detected, worst latency "
-            << worst << " s\n";
+  std::cout << detected << " of " << r.kidnaps.size() << " jumps detected, worst latency " << worst
+            << " s\n";
   // One jump lands where half the predicted lamps happen to be seen: it takes a second frame.
   EXPECT_GE(detected, static_cast<int>(r.kidnaps.size()) - 1);
   EXPECT_LE(worst, 2.0);

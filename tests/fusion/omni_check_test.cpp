@@ -32,9 +32,12 @@ std::pair<Tally, Tally> check_map(const std::string& map_file, std::uint64_t see
   const Eigen::Matrix3d P = Eigen::Vector3d(4e-4, 4e-4, 1e-4).asDiagonal();
   Tally at_truth, kidnapped;
   auto tally = [](const OmniCheckResult& r, Tally& t) {
-    if (!r.conclusive) ++t.inconclusive;
-    else if (r.consistent) ++t.consistent;
-    else ++t.inconsistent;
+    if (!r.conclusive)
+      ++t.inconclusive;
+    else if (r.consistent)
+      ++t.consistent;
+    else
+      ++t.inconsistent;
   };
   std::vector<const graph::Node*> lit;
   for (const auto& n : map.nodes())

@@ -62,8 +62,8 @@ TEST(OmniLampDetector, FindsEveryLampInViewAtItsProjection) {
       worst = std::max(worst, std::min(best, 50.0));
     }
   }
-  std::cout << expected << " lamps expected, " << found << " found within 0.5 px, worst "
-            << worst << " px\n";
+  std::cout << expected << " lamps expected, " << found << " found within 0.5 px, worst " << worst
+            << " px\n";
   EXPECT_GT(expected, 200);
   EXPECT_GE(found, expected * 97 / 100);
 }

@@ -6,8 +6,8 @@
 #include <cstring>
 #include <string>
 
-#include "lampnav/core/pose2.hpp"
 #include "blobs.hpp"
+#include "lampnav/core/pose2.hpp"
 #include "lampnav/vision/camera_models.hpp"
 
 namespace lampnav::vision {

@@ -94,9 +94,9 @@ struct OmniLampDetector::Impl {
       for (int v = 0; v < h; ++v)
         for (int u = 0; u < w; ++u)
           crop[static_cast<std::size_t>(v) * w + u] =
-              first.bright(b.u0 + u, b.v0 + v) ? g.data[(b.v0 + v) * g.row_stride() + b.u0 + u]
-                                               : 0;
-      second.label(ImageView{crop.data(), w, h, 1, 1, static_cast<std::size_t>(w)}, static_cast<std::uint8_t>(o.bloom_threshold));
+              first.bright(b.u0 + u, b.v0 + v) ? g.data[(b.v0 + v) * g.row_stride() + b.u0 + u] : 0;
+      second.label(ImageView{crop.data(), w, h, 1, 1, static_cast<std::size_t>(w)},
+                   static_cast<std::uint8_t>(o.bloom_threshold));
       if (second.blobs().empty()) {  // no saturated core: keep the blob as it was
         add(first, b, 0, 0, false, &out);
         continue;

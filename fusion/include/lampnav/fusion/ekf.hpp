@@ -22,14 +22,14 @@ using StateVector = Eigen::Vector3d;  // x (m), y (m), yaw (rad)
 using StateCovariance = Eigen::Matrix3d;
 
 struct EkfOptions {
-  double semi_axis = 0.20;              // m, half the wheel track (robot.json)
-  double wheel_variance_per_m = 1e-4;   // m^2 per m of a wheel's travel: C = diag(k|dSl|, k|dSr|)
-  double gate_probability = 0.99;       // chi-square gate on the 3-dof innovation
+  double semi_axis = 0.20;             // m, half the wheel track (robot.json)
+  double wheel_variance_per_m = 1e-4;  // m^2 per m of a wheel's travel: C = diag(k|dSl|, k|dSr|)
+  double gate_probability = 0.99;      // chi-square gate on the 3-dof innovation
   Duration history = std::chrono::seconds(2);  // how late a measurement may be
-  double max_wheel_speed = 3.0;         // m/s; a larger increment is an encoder glitch
-  double wheel_jump_slack = 0.02;       // m added to max_wheel_speed * dt before refusing
-  std::size_t max_pending = 64;         // measurements captured after the latest odometry
-  void validate() const;                // throws InputError naming the field
+  double max_wheel_speed = 3.0;                // m/s; a larger increment is an encoder glitch
+  double wheel_jump_slack = 0.02;              // m added to max_wheel_speed * dt before refusing
+  std::size_t max_pending = 64;                // measurements captured after the latest odometry
+  void validate() const;                       // throws InputError naming the field
 };
 
 // Why an input was not used. Each is counted; none changes the filter.
@@ -50,9 +50,9 @@ const char* to_string(Refusal refusal);
 struct UpdateResult {
   enum class Status { applied, pending, refused } status = Status::refused;
   std::optional<Refusal> refusal;
-  Stamp stamp;                // capture time of the measurement
-  double mahalanobis2 = 0;    // squared distance of the innovation (when computed)
-  int reapplied_steps = 0;    // history entries re-run after it
+  Stamp stamp;              // capture time of the measurement
+  double mahalanobis2 = 0;  // squared distance of the innovation (when computed)
+  int reapplied_steps = 0;  // history entries re-run after it
   bool applied() const { return status == Status::applied; }
 };
 
@@ -121,10 +121,10 @@ class PoseEkf {
 
  private:
   struct Entry {
-    FilterState state;                // after this entry
-    double d_left = 0, d_right = 0;   // the input that led here from the previous entry
-    bool measurement = false;         // an update entry (its input is zero)
-    bool accepted = false;            // the measurement passed the gate when last run
+    FilterState state;               // after this entry
+    double d_left = 0, d_right = 0;  // the input that led here from the previous entry
+    bool measurement = false;        // an update entry (its input is zero)
+    bool accepted = false;           // the measurement passed the gate when last run
     StateVector z = StateVector::Zero();
     StateCovariance R = StateCovariance::Zero();
   };

@@ -24,17 +24,17 @@
 namespace lampnav::fusion {
 
 struct KidnapMonitorOptions {
-  int window_frames = 10;         // ceiling frames in the sliding window (1 s at 10 Hz)
-  int contradicting_frames = 4;   // frames with a contradiction in the window that mean lost
-  int missing_support_frames = 4; // frames with expected lamps missing that, with two
-                                  // contradicting frames, also mean lost
-  int nis_window = 8;             // measurements in the NIS window test
-  double nis_probability = 0.9999;  // its chi-square quantile (3 * nis_window dof)
-  int omni_failures = 2;          // consecutive inconsistent omni checks that mean lost
-  int omni_strong_expected = 4;   // a check with at least this many blobs ...
+  int window_frames = 10;             // ceiling frames in the sliding window (1 s at 10 Hz)
+  int contradicting_frames = 4;       // frames with a contradiction in the window that mean lost
+  int missing_support_frames = 4;     // frames with expected lamps missing that, with two
+                                      // contradicting frames, also mean lost
+  int nis_window = 8;                 // measurements in the NIS window test
+  double nis_probability = 0.9999;    // its chi-square quantile (3 * nis_window dof)
+  int omni_failures = 2;              // consecutive inconsistent omni checks that mean lost
+  int omni_strong_expected = 4;       // a check with at least this many blobs ...
   double omni_strong_fraction = 0.5;  // ... of which at most this fraction are explained (and
                                       // as few predicted lamps seen) means lost at once
-  void validate() const;          // throws InputError naming the field
+  void validate() const;              // throws InputError naming the field
 };
 
 // What one ceiling frame says about the estimate it was labelled with.
@@ -64,9 +64,9 @@ struct OmniCheckResult {
   bool conclusive = false;
   bool consistent = true;
   bool lamp_side = false, blob_side = false;  // enough predicted lamps / seen blobs to judge
-  int expected = 0;  // clear lamps the estimate predicts in the used part of the view
-  int matched = 0;   // of those, with a blob in the expected direction (one-to-one)
-  int blobs = 0;     // blobs in the used part of the view
+  int expected = 0;         // clear lamps the estimate predicts in the used part of the view
+  int matched = 0;          // of those, with a blob in the expected direction (one-to-one)
+  int blobs = 0;            // blobs in the used part of the view
   int explained_blobs = 0;  // of those, in the direction of some map lamp
   double match_fraction() const { return expected ? double(matched) / expected : 0.0; }
   double explained_fraction() const { return blobs ? double(explained_blobs) / blobs : 1.0; }
@@ -102,9 +102,9 @@ class KidnapMonitor {
 
   // Counters over the mission.
   struct Counts {
-    std::uint64_t frames = 0, contradicting_frames = 0, unexplained_lamps = 0,
-                  missing_lamps = 0, refused_measurements = 0, nis_alarms = 0,
-                  omni_checks = 0, omni_inconsistent = 0, losses = 0;
+    std::uint64_t frames = 0, contradicting_frames = 0, unexplained_lamps = 0, missing_lamps = 0,
+                  refused_measurements = 0, nis_alarms = 0, omni_checks = 0, omni_inconsistent = 0,
+                  losses = 0;
   };
   const Counts& counts() const { return counts_; }
 

@@ -32,7 +32,7 @@ enum class LocalizerMode { tracking, lost, relocalized };
 const char* to_string(LocalizerMode mode);
 
 struct LocalizerOptions {
-  EkfOptions ekf;  // semi_axis is taken from robot.json
+  EkfOptions ekf;                          // semi_axis is taken from robot.json
   OdometryCalibrationOptions calibration;  // likewise
   CeilingPipelineOptions ceiling;
   vision::OmniDetectorOptions omni_detector;
@@ -67,11 +67,11 @@ struct LocalizerEvent {
 // Inputs the localizer did not use, by reason (besides the EKF's own refusals).
 struct LocalizerCounts {
   std::uint64_t wheel_readings = 0, ceiling_frames = 0, omni_frames = 0, global_fixes = 0;
-  std::uint64_t frames_too_old = 0;      // captured before the filter's history
-  std::uint64_t frames_while_lost = 0;   // processed for evidence only
+  std::uint64_t frames_too_old = 0;     // captured before the filter's history
+  std::uint64_t frames_while_lost = 0;  // processed for evidence only
   std::uint64_t measurements_applied = 0, measurements_refused = 0;
   std::uint64_t fixes_refused = 0;
-  std::uint64_t wheel_rebaselined = 0;   // after a refused jump, the new reading is the baseline
+  std::uint64_t wheel_rebaselined = 0;  // after a refused jump, the new reading is the baseline
 };
 
 class Localizer {

@@ -18,14 +18,14 @@ namespace lampnav::fusion {
 
 struct OdometryCalibrationOptions {
   bool enabled = true;
-  double semi_axis = 0.20;        // m (robot.json)
-  double min_travel = 0.5;        // m of travel between the two measurements of a pair
-  double min_turn = 0.3;          // rad; smaller turns do not inform turn_scale
-  double max_travel = 6.0;        // m; older measurements are forgotten
-  double forgetting = 0.995;      // per pair: old pairs fade (wheels wear, loads change)
-  double prior_drift = 0.02;      // rad/m, sigma of the prior on yaw_drift_per_m (around 0)
-  double prior_scale = 0.05;      // sigma of the prior on turn_scale (around 0)
-  double max_drift = 0.05;        // rad/m (2.9 degrees per metre); the estimate is clamped
+  double semi_axis = 0.20;    // m (robot.json)
+  double min_travel = 0.5;    // m of travel between the two measurements of a pair
+  double min_turn = 0.3;      // rad; smaller turns do not inform turn_scale
+  double max_travel = 6.0;    // m; older measurements are forgotten
+  double forgetting = 0.995;  // per pair: old pairs fade (wheels wear, loads change)
+  double prior_drift = 0.02;  // rad/m, sigma of the prior on yaw_drift_per_m (around 0)
+  double prior_scale = 0.05;  // sigma of the prior on turn_scale (around 0)
+  double max_drift = 0.05;    // rad/m (2.9 degrees per metre); the estimate is clamped
   double max_scale = 0.05;
   void validate() const;
 };

@@ -16,13 +16,13 @@
 namespace lampnav::vision {
 
 struct OmniDetectorOptions {
-  int threshold = 128;            // grey level of a lamp pixel
-  int bloom_threshold = 240;      // the second threshold for big blobs
-  int min_pixels = 3;             // smaller blobs are noise
-  int big_blob_pixels = 400;      // blobs larger than this are re-labelled at bloom_threshold
-  int max_blobs = 256;            // beyond this the frame is refused as a flood of specks
-  double max_theta_deg = 92.0;    // blobs further off-axis are ignored (horizon clutter)
-  void validate() const;          // throws InputError naming the field
+  int threshold = 128;          // grey level of a lamp pixel
+  int bloom_threshold = 240;    // the second threshold for big blobs
+  int min_pixels = 3;           // smaller blobs are noise
+  int big_blob_pixels = 400;    // blobs larger than this are re-labelled at bloom_threshold
+  int max_blobs = 256;          // beyond this the frame is refused as a flood of specks
+  double max_theta_deg = 92.0;  // blobs further off-axis are ignored (horizon clutter)
+  void validate() const;        // throws InputError naming the field
 };
 
 struct OmniBlob {
@@ -34,12 +34,12 @@ struct OmniBlob {
   double theta = 0;      // rad off the optical axis
   Eigen::Vector3d ray = Eigen::Vector3d::UnitZ();  // unit direction in the camera frame
   double angular_radius = 0;  // rad, the radius of a disc of its area, seen from the camera
-  bool from_bloom = false;  // split out of a big blob by the second threshold
+  bool from_bloom = false;    // split out of a big blob by the second threshold
 };
 
 struct OmniDetection {
   std::vector<OmniBlob> blobs;
-  int raw_blobs = 0;     // components at the first threshold
+  int raw_blobs = 0;  // components at the first threshold
   int too_small = 0, outside_view = 0, split_blooms = 0;
   bool flooded = false;  // more than max_blobs: nothing reported
 };
@@ -47,7 +47,8 @@ struct OmniDetection {
 class OmniLampDetector {
  public:
   // Throws InputError when the camera is not a pajdla_bakstein one or the options are bad.
-  explicit OmniLampDetector(const CameraDescription& camera, const OmniDetectorOptions& options = {});
+  explicit OmniLampDetector(const CameraDescription& camera,
+                            const OmniDetectorOptions& options = {});
   ~OmniLampDetector();
   OmniLampDetector(OmniLampDetector&&) noexcept;
   OmniLampDetector& operator=(OmniLampDetector&&) noexcept;
