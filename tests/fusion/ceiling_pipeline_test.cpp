@@ -13,6 +13,7 @@
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/sim/scenario.hpp"
 #include "lampnav_test.hpp"
+#include "mission_truth.hpp"
 
 namespace lampnav::fusion {
 namespace {
@@ -27,17 +28,7 @@ struct Score {
   double mean_yaw_deg() const { return sum_yaw / measurements * 180 / M_PI; }
 };
 
-Pose2 truth_at(const std::vector<io::Logged<io::TruthPose>>& truth, Stamp t) {
-  auto it = std::lower_bound(truth.begin(), truth.end(), t,
-                             [](const auto& a, Stamp s) { return a.value.stamp < s; });
-  if (it == truth.begin()) return it->value.pose;
-  if (it == truth.end()) return truth.back().value.pose;
-  const auto& b = it->value;
-  const auto& a = std::prev(it)->value;
-  const double f = to_seconds(t - a.stamp) / std::max(1e-12, to_seconds(b.stamp - a.stamp));
-  return Pose2(a.pose.translation() + f * (b.pose.translation() - a.pose.translation()),
-               a.pose.yaw() + f * wrap_angle(b.pose.yaw() - a.pose.yaw()));
-}
+using test::truth_at;
 
 Score corridor(double bump_rad, const std::set<std::string>& failed, std::uint64_t seed) {
   const std::string geojson = test::slurp(test::source_path("maps/office_floor.geojson"));

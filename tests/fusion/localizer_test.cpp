@@ -14,6 +14,7 @@
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/sim/scenario.hpp"
 #include "lampnav_test.hpp"
+#include "mission_truth.hpp"
 
 namespace lampnav::fusion {
 namespace {
@@ -21,19 +22,7 @@ namespace {
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 
-Pose2 truth_at(const std::vector<io::Logged<io::TruthPose>>& truth, Stamp t) {
-  auto it = std::lower_bound(truth.begin(), truth.end(), t,
-                             [](const auto& a, Stamp s) { return a.value.stamp < s; });
-  if (it == truth.begin()) return it->value.pose;
-  if (it == truth.end()) return truth.back().value.pose;
-  const auto& b = it->value;
-  const auto& a = std::prev(it)->value;
-  // A kidnap is a jump between two truth samples: no interpolation across it.
-  if ((b.pose.translation() - a.pose.translation()).norm() > 0.5) return a.pose;
-  const double f = to_seconds(t - a.stamp) / std::max(1e-12, to_seconds(b.stamp - a.stamp));
-  return Pose2(a.pose.translation() + f * (b.pose.translation() - a.pose.translation()),
-               a.pose.yaw() + f * wrap_angle(b.pose.yaw() - a.pose.yaw()));
-}
+using test::truth_at;
 
 struct Kidnapped {
   Stamp at;                    // lifted (log event)

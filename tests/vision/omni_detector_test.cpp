@@ -24,14 +24,18 @@ struct Museum {
       for (const auto& l : n.lamps) out.push_back(&l);
     return out;
   }
+  // Every lamp drawn: nobody in the way, no spurious light.
+  sim::OmniRenderer clean_renderer() const {
+    sim::OmniRenderOptions ro;
+    ro.occlusion_probability = 0;
+    ro.spurious_per_image = 0;
+    return sim::OmniRenderer(cam, ro);
+  }
 };
 
 TEST(OmniLampDetector, FindsEveryLampInViewAtItsProjection) {
   Museum m;
-  sim::OmniRenderOptions ro;
-  ro.occlusion_probability = 0;
-  ro.spurious_per_image = 0;
-  const sim::OmniRenderer renderer(m.cam, ro);
+  const sim::OmniRenderer renderer = m.clean_renderer();
   OmniLampDetector det(m.cam);
   std::mt19937_64 rng(5);
   std::uniform_real_distribution<double> u(0, 1);
@@ -96,10 +100,7 @@ TEST(OmniLampDetector, BlobCarriesItsRayAndGeometry) {
 
 TEST(OmniLampDetector, SplitsBloomsWithTheSecondThreshold) {
   Museum m;
-  sim::OmniRenderOptions ro;
-  ro.occlusion_probability = 0;
-  ro.spurious_per_image = 0;
-  const sim::OmniRenderer renderer(m.cam, ro);
+  const sim::OmniRenderer renderer = m.clean_renderer();
   OmniLampDetector det(m.cam);
   std::mt19937_64 rng(1);
   // Under the B1 cluster (3.25 m lamps, 1.45 m above the camera): they bloom together, and the
