@@ -103,6 +103,7 @@ struct Localizer::Impl {
       const auto n = ceiling_geometry->predict(pose, l->xyz);
       if (!n) continue;
       const double h = std::max(0.5, l->xyz.z() - ceiling_geometry->mount_origin().z());
+      // Margin: 3 sigma of position, 3 sigma of heading over a 2 m lever, and most of the lamp.
       const double margin =
           fx * (3 * sigma + std::sqrt(prior.P(2, 2)) * 3 * 2.0 + 0.6 * l->length) / h;
       const Eigen::Vector2d px = cam.pixel_of_normalized(*n);
