@@ -230,10 +230,11 @@ CeilingObservation CeilingPipeline::process(Stamp stamp, const vision::ImageView
   if (!labelled.empty()) {
     std::string why;
     out.measurement = measure_pose(m.geometry, m.camera.pinhole.fx, labelled, predicted, stamp,
-                                   m.o.measurement, &why);
+                                   m.o.measurement, &why, &out.no_measurement);
     if (!out.measurement) out.no_measurement_reason = why;
   } else if (!out.lamps.empty()) {
     out.no_measurement_reason = "no labelled lamp in full view";
+    out.no_measurement = PoseRefusal::no_usable_lamp;
   }
   return out;
 }

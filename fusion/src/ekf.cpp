@@ -98,6 +98,23 @@ bool is_covariance(const Matrix3d& P) {
   return llt.matrixL().toDenseMatrix().diagonal().minCoeff() > 1e-12 * std::sqrt(scale);
 }
 
+namespace {
+
+// The fraction of the way from `a` to `b` at which `t` lies: how an odometry step spanning a
+// capture time is split (state_at and split_at must agree exactly).
+double fraction(Stamp a, Stamp b, Stamp t) {
+  return static_cast<double>((t - a).count()) / static_cast<double>((b - a).count());
+}
+
+}  // namespace
+
+std::size_t PoseEkf::first_after(Stamp t) const {
+  return static_cast<std::size_t>(
+      std::upper_bound(history_.begin(), history_.end(), t,
+                       [](Stamp s, const Entry& e) { return s < e.state.stamp; }) -
+      history_.begin());
+}
+
 PoseEkf::PoseEkf(const EkfOptions& options) : o_(options) {
   o_.validate();
   gate_ = chi_square_quantile(o_.gate_probability, 3);
@@ -178,13 +195,8 @@ void PoseEkf::rerun_from(std::size_t i) {
 }
 
 bool PoseEkf::known_measurement(Stamp stamp) const {
-  auto it = std::upper_bound(history_.begin(), history_.end(), stamp,
-                             [](Stamp t, const Entry& e) { return t < e.state.stamp; });
-  for (; it != history_.begin(); --it) {
-    const Entry& e = *std::prev(it);
-    if (e.state.stamp != stamp) break;
-    if (e.measurement) return true;
-  }
+  for (std::size_t i = first_after(stamp); i > 0 && history_[i - 1].state.stamp == stamp; --i)
+    if (history_[i - 1].measurement) return true;
   return std::any_of(pending_.begin(), pending_.end(),
                      [&](const Pending& p) { return p.stamp == stamp; });
 }
@@ -192,16 +204,15 @@ bool PoseEkf::known_measurement(Stamp stamp) const {
 std::optional<FilterState> PoseEkf::state_at(Stamp t) const {
   if (history_.empty() || t < history_.front().state.stamp || t > history_.back().state.stamp)
     return std::nullopt;
-  auto it = std::upper_bound(history_.begin(), history_.end(), t,
-                             [](Stamp s, const Entry& e) { return s < e.state.stamp; });
-  const Entry& prev = *std::prev(it);
-  if (it == history_.end() || prev.state.stamp == t) return prev.state;
-  // `it` is an input entry spanning t: interpolate its increments linearly in time, exactly as
-  // update() splits it.
-  const double f = static_cast<double>((t - prev.state.stamp).count()) /
-                   static_cast<double>((it->state.stamp - prev.state.stamp).count());
+  const std::size_t i = first_after(t);
+  const Entry& prev = history_[i - 1];
+  if (i == history_.size() || prev.state.stamp == t) return prev.state;
+  // history_[i] is an input entry spanning t: interpolate its increments linearly in time,
+  // exactly as split_at() splits it.
+  const Entry& later = history_[i];
+  const double f = fraction(prev.state.stamp, later.state.stamp, t);
   FilterState s;
-  step(prev.state, f * it->d_left, f * it->d_right, t, &s);
+  step(prev.state, f * later.d_left, f * later.d_right, t, &s);
   return s;
 }
 
@@ -255,15 +266,11 @@ UpdateResult PoseEkf::update(Stamp t, const Pose2& pose, const StateCovariance& 
 }
 
 std::size_t PoseEkf::split_at(Stamp t, const FilterState& at_t) {
-  auto it = std::upper_bound(history_.begin(), history_.end(), t,
-                             [](Stamp s, const Entry& e) { return s < e.state.stamp; });
-  const std::size_t i = static_cast<std::size_t>(it - history_.begin());
+  const std::size_t i = first_after(t);
   if (i == history_.size() || history_[i - 1].state.stamp == t) return i - 1;
   // Split the input entry spanning t exactly as state_at() interpolates it.
   Entry& later = history_[i];
-  const Stamp before = history_[i - 1].state.stamp;
-  const double f = static_cast<double>((t - before).count()) /
-                   static_cast<double>((later.state.stamp - before).count());
+  const double f = fraction(history_[i - 1].state.stamp, later.state.stamp, t);
   Entry first;
   first.state = at_t;
   first.d_left = f * later.d_left;
@@ -303,10 +310,9 @@ void PoseEkf::trim() {
   // Lazily, in chunks, so that a step costs O(1) on average; the horizon itself is enforced
   // by update()'s too_old test, not by what happens to be kept.
   if (history_.size() < 512) return;
-  const Stamp cutoff = history_.back().state.stamp - o_.history;
-  auto it = std::upper_bound(history_.begin(), history_.end(), cutoff,
-                             [](Stamp s, const Entry& e) { return s < e.state.stamp; });
-  const std::ptrdiff_t keep_from = std::max<std::ptrdiff_t>(0, (it - history_.begin()) - 1);
+  const std::size_t after = first_after(history_.back().state.stamp - o_.history);
+  const std::ptrdiff_t keep_from =
+      std::max<std::ptrdiff_t>(0, static_cast<std::ptrdiff_t>(after) - 1);
   if (keep_from < static_cast<std::ptrdiff_t>(history_.size()) / 2) return;
   history_.erase(history_.begin(), history_.begin() + keep_from);
 }

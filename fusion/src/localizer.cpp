@@ -45,8 +45,8 @@ struct Localizer::Impl {
   std::optional<std::pair<double, double>> last_wheels;
   CeilingObservation last_ceiling;
   vision::OmniDetection last_omni;
-  Stamp last_omni_stamp, last_omni_check;
-  bool have_omni = false, omni_checked = false;
+  Stamp last_omni_stamp;
+  std::optional<Stamp> last_omni_check;
   std::vector<LocalizerEvent> events;
   LocalizerCounts counts;
 
@@ -129,8 +129,7 @@ struct Localizer::Impl {
       if (!l.lamp && l.outcome == LabelOutcome::no_candidate) ++e.unexplained;
     }
     if (ceiling_model) e.expected_missing = expected_missing(ob, prior);
-    e.inconsistent = !ob.measurement && e.labelled > 0 &&
-                     ob.no_measurement_reason.find("disagree") != std::string::npos;
+    e.inconsistent = ob.no_measurement == PoseRefusal::labels_disagree;
     if (mode == LocalizerMode::lost) {
       ++counts.frames_while_lost;
       return;
@@ -177,14 +176,9 @@ bool Localizer::initialized() const { return impl_->ekf.initialized(); }
 std::optional<Refusal> Localizer::wheels(Stamp stamp, double left, double right) {
   Impl& m = *impl_;
   ++m.counts.wheel_readings;
-  if (!std::isfinite(left) || !std::isfinite(right)) {
-    return m.ekf.predict(stamp, std::nan(""), 0.0);  // counted by the filter
-  }
-  if (!m.last_wheels) {
-    m.last_wheels = {left, right};
-    return std::nullopt;
-  }
-  const double dl = left - m.last_wheels->first, dr = right - m.last_wheels->second;
+  // The first reading is the baseline (no motion); NaN or inf is refused by the filter.
+  const auto [left0, right0] = m.last_wheels.value_or(std::pair{left, right});
+  const double dl = left - left0, dr = right - right0;
   const auto [cl, cr] = m.calibration.correct(dl, dr);
   const auto r = m.ekf.predict(stamp, cl, cr);
   if (!r) {
@@ -237,13 +231,11 @@ const vision::OmniDetection& Localizer::omni_frame(Stamp stamp, const vision::Im
     throw InputError({"", "robot.json", "cameras"}, "the robot has no omni_camera");
   m.last_omni = m.omni_detector->detect(image);
   m.last_omni_stamp = stamp;
-  m.have_omni = true;
   ++m.counts.omni_frames;
   if (m.mode == LocalizerMode::lost) return m.last_omni;
-  if (m.omni_checked && stamp - m.last_omni_check < m.o.omni_check_period) return m.last_omni;
+  if (m.last_omni_check && stamp - *m.last_omni_check < m.o.omni_check_period) return m.last_omni;
   const std::optional<FilterState> prior = prior_at(stamp);
   if (!prior) return m.last_omni;
-  m.omni_checked = true;
   m.last_omni_check = stamp;
   const OmniCheckResult r = m.omni_check->check(prior->pose(), prior->P, m.last_omni.blobs);
   if (m.mode == LocalizerMode::relocalized && r.conclusive && r.consistent)
@@ -289,7 +281,7 @@ LocalizerEstimate Localizer::estimate() const {
 
 LocalizerMode Localizer::mode() const { return impl_->mode; }
 const vision::OmniDetection* Localizer::last_omni() const {
-  return impl_->have_omni ? &impl_->last_omni : nullptr;
+  return impl_->counts.omni_frames > 0 ? &impl_->last_omni : nullptr;
 }
 Stamp Localizer::last_omni_stamp() const { return impl_->last_omni_stamp; }
 const std::vector<LocalizerEvent>& Localizer::events() const { return impl_->events; }

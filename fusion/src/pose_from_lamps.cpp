@@ -47,9 +47,12 @@ struct Term {
 std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry, double fx,
                                             const std::vector<LabelledLamp>& lamps,
                                             const Pose2& predicted, Stamp stamp,
-                                            const PoseMeasurementOptions& o, std::string* why) {
-  auto refuse = [&](const std::string& reason) -> std::optional<PoseMeasurement> {
+                                            const PoseMeasurementOptions& o, std::string* why,
+                                            PoseRefusal* refusal) {
+  if (refusal) *refusal = PoseRefusal::none;
+  auto refuse = [&](PoseRefusal kind, const std::string& reason) -> std::optional<PoseMeasurement> {
     if (why) *why = reason;
+    if (refusal) *refusal = kind;
     return std::nullopt;
   };
   std::vector<Term> terms;
@@ -79,10 +82,12 @@ std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry, dou
     terms.push_back(t);
     height_sum += l.lamp->xyz.z();
   }
-  if (terms.empty()) return refuse("no fully visible or completed labelled lamp");
+  if (terms.empty())
+    return refuse(PoseRefusal::no_usable_lamp, "no fully visible or completed labelled lamp");
   int axes = 0;
   for (const auto& t : terms) axes += t.has_axis;
-  if (terms.size() == 1 && axes == 0) return refuse("one round lamp does not give the heading");
+  if (terms.size() == 1 && axes == 0)
+    return refuse(PoseRefusal::round_lamp_no_heading, "one round lamp does not give the heading");
 
   // Initial heading: a lamp's axis, on the branch (of two, pi apart) nearest the prediction;
   // without axes, the direction between the first two lamps.
@@ -136,18 +141,17 @@ std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry, dou
       }
     }
     const Vector3d step = -H.ldlt().solve(g);
-    if (!step.allFinite()) return refuse("the lamps do not determine the pose");
+    if (!step.allFinite())
+      return refuse(PoseRefusal::undetermined, "the lamps do not determine the pose");
     x += step;
     if (step.head<2>().norm() < 1e-9 && std::fabs(step.z()) < 1e-10) break;
   }
   const int dof = static_cast<int>(2 * terms.size()) + axes - 3;
-  // Beyond six dof (four lamps and more) the gate scales the six-dof quantile per dof.
-  const double limit = dof <= 0   ? 0
-                       : dof <= 6 ? chi_square_quantile(o.consistency_probability, dof)
-                                  : chi_square_quantile(o.consistency_probability, 6) * dof / 6.0;
+  const double limit = dof <= 0 ? 0 : chi_square_quantile(o.consistency_probability, dof);
   if (dof > 0 && chi2 > limit)
-    return refuse("the lamps disagree on the pose (chi2 " + std::to_string(chi2) + " over " +
-                  std::to_string(dof) + " dof): a lamp is mislabelled");
+    return refuse(PoseRefusal::labels_disagree,
+                  "the lamps disagree on the pose (chi2 " + std::to_string(chi2) + " over " +
+                      std::to_string(dof) + " dof): a lamp is mislabelled");
   PoseMeasurement m;
   m.stamp = stamp;
   m.pose = Pose2(x.x(), x.y(), wrap_angle(x.z()));

@@ -1,7 +1,7 @@
 // The ceiling pipeline over the simulated `corridor` scenario (E1 -> K1 on the office floor), read
 // back from its mission log: labels checked against truth, pose measurements scored against truth.
-// Between measurements the pose is dead-reckoned from the wheels with a covariance grown per
-// paper 2's input noise model; each measurement resets it (the EKF of issue 5 does this properly).
+// Between measurements the pose is dead-reckoned from the wheels with the EKF's motion and noise
+// model; each measurement resets it (the Localizer tests run the full filter).
 
 #include <unistd.h>
 
@@ -9,6 +9,7 @@
 #include <set>
 
 #include "lampnav/fusion/ceiling_pipeline.hpp"
+#include "lampnav/fusion/ekf.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/sim/scenario.hpp"
@@ -56,6 +57,8 @@ Score corridor(double bump_rad, const std::set<std::string>& failed, std::uint64
   Pose2 pose = s.start;
   Matrix3d P = Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal();
   const double a = robot.semi_axis;
+  EkfOptions ekf;
+  ekf.semi_axis = a;
   std::size_t w = 0;
   double left = log.wheels.front().value.left, right = log.wheels.front().value.right;
   Score sc;
@@ -66,20 +69,13 @@ Score corridor(double bump_rad, const std::set<std::string>& failed, std::uint64
       const double dl = log.wheels[w].value.left - left, dr = log.wheels[w].value.right - right;
       left = log.wheels[w].value.left;
       right = log.wheels[w].value.right;
-      const double ds = (dr + dl) / 2, dth = (dr - dl) / (2 * a), mid = pose.yaw() + dth / 2;
-      Matrix3d F = Matrix3d::Identity();
-      F(0, 2) = -ds * std::sin(mid);
-      F(1, 2) = ds * std::cos(mid);
-      Eigen::Matrix<double, 3, 2> Ju;  // d state / d (dl, dr)
-      Ju << std::cos(mid) / 2 + ds * std::sin(mid) / (4 * a),
-          std::cos(mid) / 2 - ds * std::sin(mid) / (4 * a),
-          std::sin(mid) / 2 - ds * std::cos(mid) / (4 * a),
-          std::sin(mid) / 2 + ds * std::cos(mid) / (4 * a), -1 / (2 * a), 1 / (2 * a);
-      // Per wheel: random error 0.01 m/sqrt(m) and a 1% scale error, generous on the sim's.
-      const Eigen::Vector2d var(1e-4 * std::fabs(dl) + 1e-4 * dl * dl,
-                                1e-4 * std::fabs(dr) + 1e-4 * dr * dr);
-      P = F * P * F.transpose() + Ju * var.asDiagonal() * Ju.transpose();
-      pose = Pose2(pose.x() + ds * std::cos(mid), pose.y() + ds * std::sin(mid), pose.yaw() + dth);
+      // The EKF's motion model and input noise, without its updates.
+      const Eigen::Vector3d x(pose.x(), pose.y(), pose.yaw());
+      Matrix3d F;
+      motion_jacobians(x, dl, dr, a, &F, nullptr);
+      P = F * P * F.transpose() + process_noise(x, dl, dr, ekf);
+      const Eigen::Vector3d next = predict_motion(x, dl, dr, a);
+      pose = Pose2(next.x(), next.y(), next.z());
     }
     const Image8 img = io::decode_image(f.value.data, "frame");
     const CeilingObservation ob = pipeline.process(t, vision::ImageView::of(img), pose, P);

@@ -284,7 +284,8 @@ TEST(Localizer, DomusKidnapEveryJumpDetected) {
   }
   std::cout << detected << " of " << r.kidnaps.size() << " jumps detected, worst latency " << worst
             << " s\n";
-  // One jump lands where half the predicted lamps happen to be seen: it takes a second frame.
+  // One jump (24 s) gives a check that is inconsistent but not beyond doubt; the loss comes with
+  // the next image, after the next jump.
   EXPECT_GE(detected, static_cast<int>(r.kidnaps.size()) - 1);
   EXPECT_LE(worst, 2.0);
   EXPECT_EQ(r.false_alarms, 0);

@@ -86,6 +86,7 @@ struct CeilingObservation {
   std::vector<int> ended_tracks;
   std::optional<PoseMeasurement> measurement;
   std::string no_measurement_reason;  // when lamps were seen but gave no measurement
+  PoseRefusal no_measurement = PoseRefusal::none;
   vision::DetectionStats detection;
 };
 

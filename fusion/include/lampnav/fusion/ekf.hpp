@@ -147,6 +147,8 @@ class PoseEkf {
   void rerun_from(std::size_t index);
   void trim();
   bool known_measurement(Stamp stamp) const;
+  // Index of the first history entry stamped after t (history_.size() when none is).
+  std::size_t first_after(Stamp t) const;
 
   EkfOptions o_;
   double gate_;

@@ -45,12 +45,22 @@ struct PoseMeasurement {
   int dof = 0;      // residual degrees of freedom
 };
 
-// Measures the pose; nullopt with `why` when the lamps cannot give one (none usable, a single
-// round lamp, labels that disagree). `fx` converts pixel sigmas to normalized units.
+// Why the lamps gave no pose.
+enum class PoseRefusal {
+  none,
+  no_usable_lamp,
+  round_lamp_no_heading,
+  undetermined,
+  labels_disagree
+};
+
+// Measures the pose; nullopt with `why` (words) and `refusal` (kind) when the lamps cannot give
+// one. `fx` converts pixel sigmas to normalized units.
 std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry, double fx,
                                             const std::vector<LabelledLamp>& lamps,
                                             const Pose2& predicted, Stamp stamp,
                                             const PoseMeasurementOptions& options,
-                                            std::string* why = nullptr);
+                                            std::string* why = nullptr,
+                                            PoseRefusal* refusal = nullptr);
 
 }  // namespace lampnav::fusion
