@@ -1,14 +1,25 @@
 // The pose EKF at odometry rate: one prediction, one gated update, and a measurement 1 s late
 // (100 odometry steps at 100 Hz re-applied). Targets (issue 5): 100 ns, 500 ns, 20 us.
+// Global localization from one omnidirectional image on the museum map, both methods, and one
+// merit evaluation. Targets (issue 6): `paper` 2 ms, `default` 5 ms per image.
 
 #include <benchmark/benchmark.h>
 
+#include <random>
+
 #include "lampnav/fusion/ekf.hpp"
+#include "lampnav/fusion/global_localizer.hpp"
+#include "lampnav/fusion/merit.hpp"
+#include "lampnav/graph/geojson.hpp"
+#include "lampnav/sim/renderers.hpp"
 
 namespace {
 
 using namespace lampnav;
 using fusion::PoseEkf;
+namespace graph = lampnav::graph;
+namespace vision = lampnav::vision;
+namespace sim = lampnav::sim;
 
 const Eigen::Matrix3d kP0 = Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal();
 const Eigen::Matrix3d kR = Eigen::Vector3d(4e-4, 4e-4, 1e-4).asDiagonal();
@@ -65,5 +76,88 @@ void BM_EkfLateUpdateOneSecond(benchmark::State& state) {
 BENCHMARK(BM_EkfLateUpdateOneSecond)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
+
+// Twenty museum views from random places in the halls (floor bumps on), detected once.
+struct MuseumViews {
+  graph::TopologicalMap map;
+  RobotDescription robot;
+  std::vector<vision::OmniDetection> detections;
+  MuseumViews() {
+    const std::string src = LAMPNAV_SOURCE_DIR;
+    map = graph::read_map(src + "/maps/domus_museum.geojson").map;
+    robot = read_robot_description(src + "/maps/robots/pioneer.json");
+    const CameraDescription& cam = *robot.find_camera("omni_camera");
+    std::vector<const graph::Lamp*> lamps;
+    std::vector<const graph::Node*> halls;
+    for (const auto& n : map.nodes()) {
+      halls.push_back(&n);
+      for (const auto& l : n.lamps) lamps.push_back(&l);
+    }
+    const sim::OmniRenderer renderer(cam, sim::OmniRenderOptions{});
+    vision::OmniLampDetector detector(cam);
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::normal_distribution<double> bump(0, 0.5 * M_PI / 180);
+    while (detections.size() < 20) {
+      const graph::Polygon& region = halls[rng() % halls.size()]->region;
+      const auto box = region.bounds();
+      const Eigen::Vector2d p(box.min.x() + u(rng) * (box.max.x() - box.min.x()),
+                              box.min.y() + u(rng) * (box.max.y() - box.min.y()));
+      if (!region.contains(p)) continue;
+      const Image8 img =
+          renderer.render(Pose2(p, 2 * M_PI * u(rng)), {bump(rng), bump(rng)}, lamps, rng);
+      detections.push_back(detector.detect(vision::ImageView::of(img)));
+    }
+  }
+  const CameraDescription& cam() const { return *robot.find_camera("omni_camera"); }
+};
+
+const MuseumViews& museum() {
+  static const MuseumViews views;
+  return views;
+}
+
+void locate(benchmark::State& state, fusion::GlobalMethod method) {
+  const MuseumViews& m = museum();
+  const fusion::GlobalLocalizer global(m.map, m.cam());
+  std::size_t k = 0, evaluations = 0, images = 0;
+  for (auto _ : state) {
+    const auto r = global.locate(m.detections[k++ % m.detections.size()], method);
+    evaluations += r.merit_evaluations;
+    ++images;
+    benchmark::DoNotOptimize(r.hypotheses.data());
+  }
+  state.counters["evaluations"] = double(evaluations) / double(images);
+}
+
+void BM_GlobalLocalizationPaper(benchmark::State& state) {
+  locate(state, fusion::GlobalMethod::paper);
+}
+BENCHMARK(BM_GlobalLocalizationPaper)->Unit(benchmark::kMillisecond);
+
+void BM_GlobalLocalizationDefault(benchmark::State& state) {
+  locate(state, fusion::GlobalMethod::lamp_pairs);
+}
+BENCHMARK(BM_GlobalLocalizationDefault)->Unit(benchmark::kMillisecond);
+
+// One merit evaluation (Alg. 1 + Alg. 2) at a random pose.
+void BM_MeritEvaluation(benchmark::State& state) {
+  const MuseumViews& m = museum();
+  const fusion::CeilingMapProjection projection(m.map, m.cam());
+  std::vector<Eigen::Vector2d> detected;
+  for (const auto& b : m.detections.front().blobs) detected.push_back(b.centroid_px);
+  const fusion::MeritFunction merit(detected, 25.0, 1024, 1024);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> x(-8, 28), y(-12, 4), yaw(-M_PI, M_PI);
+  std::vector<Pose2> poses;
+  for (int i = 0; i < 1024; ++i) poses.emplace_back(x(rng), y(rng), yaw(rng));
+  std::vector<Eigen::Vector2d> px;
+  std::size_t k = 0;
+  for (auto _ : state) {
+    projection.project(poses[k++ % poses.size()], px);
+    benchmark::DoNotOptimize(merit(px).value);
+  }
+}
+BENCHMARK(BM_MeritEvaluation);
 
 BENCHMARK_MAIN();

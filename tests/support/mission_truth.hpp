@@ -16,6 +16,7 @@ inline Pose2 truth_at(const std::vector<io::Logged<io::TruthPose>>& truth, Stamp
   if (it == truth.begin()) return it->value.pose;
   if (it == truth.end()) return truth.back().value.pose;
   const auto& b = it->value;
+  if (b.stamp == t) return b.pose;
   const auto& a = std::prev(it)->value;
   if ((b.pose.translation() - a.pose.translation()).norm() > 0.5) return a.pose;
   const double f = to_seconds(t - a.stamp) / std::max(1e-12, to_seconds(b.stamp - a.stamp));
