@@ -120,5 +120,178 @@ TEST(GlobalLocalizer, DomusGlobalRunWithoutBumps) {
   EXPECT_LE(ours.mean_pos(), 0.03);
 }
 
+// A hall whose lamps sit on a regular 3 x 2 grid: every view has a twin turned half a turn.
+graph::TopologicalMap symmetric_hall() {
+  std::string lamps;
+  int k = 0;
+  for (double x : {-4.0, 0.0, 4.0})
+    for (double y : {-2.0, 2.0}) {
+      lamps += std::string(k ? ", " : "") + R"({"id": "L)" + std::to_string(k) +
+               R"(", "xyz": [)" + std::to_string(x) + ", " + std::to_string(y) +
+               R"(, 6.0], "shape": "disc", "size": [0.4]})";
+      ++k;
+    }
+  const std::string text =
+      R"({"type": "FeatureCollection", "name": "symmetric", "lampnav": {"format": 1, "units": "m", "frame": "map"},
+      "features": [{"type": "Feature", "geometry": {"type": "Point", "coordinates": [0.0, 0.0]},
+      "properties": {"id": 1, "frame": "map", "metadata": {"name": "H", "place": "hall", "lamps": [)" +
+      lamps + R"(], "region": {"x_values": [-7, 7, 7, -7], "y_values": [-4, -4, 4, 4]}}}}]})";
+  return graph::parse_map(text, "symmetric.geojson").map;
+}
+
+vision::OmniDetection render_and_detect(const CameraDescription& cam,
+                                        const graph::TopologicalMap& map, const Pose2& pose,
+                                        std::uint64_t seed) {
+  std::vector<const graph::Lamp*> lamps;
+  for (const auto& n : map.nodes())
+    for (const auto& l : n.lamps) lamps.push_back(&l);
+  sim::OmniRenderOptions ro;
+  ro.occlusion_probability = 0;
+  ro.spurious_per_image = 0;
+  std::mt19937_64 rng(seed);
+  const Image8 img = sim::OmniRenderer(cam, ro).render(pose, {}, lamps, rng);
+  vision::OmniLampDetector detector(cam);
+  return detector.detect(vision::ImageView::of(img));
+}
+
+TEST(GlobalLocalizer, SymmetricCeilingGivesSeveralHypothesesAndSaysSo) {
+  const Museum m;
+  const graph::TopologicalMap hall = symmetric_hall();
+  const Pose2 truth(1.3, 0.7, 0.4);
+  const auto d = render_and_detect(m.cam(), hall, truth, 5);
+  const GlobalLocalization r = GlobalLocalizer(hall, m.cam()).locate(d);
+  ASSERT_TRUE(r.found()) << r.why;
+  EXPECT_TRUE(r.ambiguous);
+  EXPECT_NE(r.why.find("symmetric"), std::string::npos) << r.why;
+  ASSERT_GE(r.hypotheses.size(), 2u);
+  // The truth and its twin (half a turn about the hall's centre) are both there.
+  const Pose2 twin(-truth.x(), -truth.y(), wrap_angle(truth.yaw() + M_PI));
+  auto has = [&](const Pose2& p) {
+    for (const auto& h : r.hypotheses)
+      if ((h.pose.translation() - p.translation()).norm() < 0.1 &&
+          std::abs(wrap_angle(h.pose.yaw() - p.yaw())) < 1 * M_PI / 180)
+        return true;
+    return false;
+  };
+  EXPECT_TRUE(has(truth));
+  EXPECT_TRUE(has(twin));
+  double total = 0;
+  for (const auto& h : r.hypotheses) {
+    total += h.weight;
+    ASSERT_NE(h.node, nullptr);
+    EXPECT_EQ(h.node->name, "H");
+  }
+  EXPECT_NEAR(total, 1.0, 1e-9);
+}
+
+TEST(GlobalLocalizer, HonoursTheCameraMount) {
+  Museum m;
+  CameraDescription cam = m.cam();
+  cam.mount.xyz = Vector3d(0.25, -0.1, 1.4);
+  cam.mount.rpy = Vector3d(0.0, 0.0, M_PI / 2);  // turned a quarter on the robot
+  const Pose2 truth(6.2, -3.1, 2.0);
+  const auto d = render_and_detect(cam, m.map, truth, 9);
+  const GlobalLocalizer global(m.map, cam);
+  for (GlobalMethod method : {GlobalMethod::lamp_pairs, GlobalMethod::paper}) {
+    const GlobalLocalization r = global.locate(d, method);
+    ASSERT_TRUE(r.found()) << r.why;
+    const double tol = method == GlobalMethod::paper ? 1.5 : 0.05;
+    EXPECT_LT((r.hypotheses.front().pose.translation() - truth.translation()).norm(), tol)
+        << to_string(method);
+  }
+}
+
+TEST(GlobalLocalizer, PaperMethodRunsThePublishedCountAndRepeats) {
+  const Museum m;
+  const auto d = render_and_detect(m.cam(), m.map, Pose2(3.0, -2.5, 1.0), 3);
+  const GlobalLocalizer global(m.map, m.cam());
+  const GlobalLocalization a = global.locate(d, GlobalMethod::paper);
+  const GlobalLocalization b = global.locate(d, GlobalMethod::paper);
+  EXPECT_EQ(a.merit_evaluations, 2502);
+  ASSERT_TRUE(a.found());
+  EXPECT_EQ(a.hypotheses.front().pose.vector(), b.hypotheses.front().pose.vector());
+  // Ranked by merit, the best first.
+  for (std::size_t k = 1; k < a.hypotheses.size(); ++k)
+    EXPECT_LE(a.hypotheses[k - 1].merit, a.hypotheses[k].merit);
+}
+
+TEST(CeilingMapProjection, AgreesWithTheFisheyeModel) {
+  const Museum m;
+  const CeilingMapProjection projection(m.map, m.cam());
+  const vision::FisheyeCamera model(m.cam());
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> x(-8, 28), y(-12, 4), yaw(-M_PI, M_PI);
+  std::vector<Vector2d> px;
+  std::vector<int> index;
+  int compared = 0;
+  for (int k = 0; k < 200; ++k) {
+    const Pose2 p(x(rng), y(rng), yaw(rng));
+    projection.project(p, px, &index);
+    for (std::size_t i = 0; i < px.size(); ++i) {
+      const Vector3d L = projection.lamps()[index[i]]->xyz;
+      const Eigen::Vector2d d = p.transform_to(L.head<2>());
+      const Vector3d cam = Vector3d(d.x(), d.y(), L.z()) - m.cam().mount.xyz;
+      const auto expected = model.project(cam);
+      ASSERT_TRUE(expected);
+      EXPECT_LT((*expected - px[i]).norm(), 0.01);
+      ++compared;
+    }
+  }
+  EXPECT_GT(compared, 2000);
+}
+
+TEST(MeritFunction, MatchesWithinTheThresholdNearestAndOneToOne) {
+  // Detections at (100, 100), (130, 100), (400, 400); threshold 20 px.
+  const MeritFunction merit({{100, 100}, {130, 100}, {400, 400}}, 20.0, 1024, 1024);
+  std::vector<std::pair<int, int>> matches;
+  // Two lamps want detection 0: the nearer (3 px) wins; the other (5 px) is left unmatched
+  // although detection 1 lies 25 px from it (beyond the threshold). Detection 2 is 30 px from
+  // the last lamp: unmatched.
+  const Merit r = merit({{103, 100}, {95, 100}, {430, 400}}, &matches);
+  ASSERT_EQ(r.matched, 1);
+  ASSERT_EQ(matches.size(), 1u);
+  EXPECT_EQ(matches[0], std::make_pair(0, 0));
+  EXPECT_NEAR(r.error_px, 3 + 20 + 20, 1e-9);  // unmatched detections cost the threshold
+  EXPECT_NEAR(r.value, 43.0, 1e-9);
+  // The nearest condition: a lamp between two detections takes the nearer one.
+  const Merit s = merit({{118, 100}});
+  EXPECT_EQ(s.matched, 1);
+  EXPECT_NEAR(s.error_px, 12 + 20 + 20, 1e-9);
+  EXPECT_TRUE(std::isinf(merit({{700, 700}}).value));  // nothing matched
+}
+
+TEST(GlobalLocalizer, BadImagesGiveNoHypothesisAndSayWhy) {
+  const Museum m;
+  const GlobalLocalizer global(m.map, m.cam());
+  vision::OmniLampDetector detector(m.cam());
+  // Dark: no lamp.
+  Image8 dark(1024, 1024, 1);
+  for (GlobalMethod method : {GlobalMethod::lamp_pairs, GlobalMethod::paper}) {
+    const auto r = global.locate(detector.detect(vision::ImageView::of(dark)), method);
+    EXPECT_FALSE(r.found());
+    EXPECT_NE(r.why.find("no lamp"), std::string::npos) << r.why;
+  }
+  // Thousands of bright specks.
+  Image8 specks(1024, 1024, 1);
+  std::mt19937_64 rng(2);
+  for (int k = 0; k < 5000; ++k) {
+    const int u = 100 + int(rng() % 824), v = 100 + int(rng() % 824);
+    for (int dv = 0; dv < 2; ++dv)
+      for (int du = 0; du < 2; ++du) specks.at(u + du, v + dv) = 255;
+  }
+  const auto flood = global.locate(detector.detect(vision::ImageView::of(specks)));
+  EXPECT_FALSE(flood.found());
+  EXPECT_NE(flood.why.find("specks"), std::string::npos) << flood.why;
+  // One lamp: a pose needs two.
+  vision::OmniDetection one = render_and_detect(m.cam(), m.map, Pose2(5.9, -2.0, 0), 1);
+  one.blobs.resize(1);
+  const auto single = global.locate(one);
+  EXPECT_FALSE(single.found());
+  EXPECT_NE(single.why.find("needs two"), std::string::npos) << single.why;
+  // An image of another size is refused by the detector, naming it.
+  Image8 small(640, 480, 1);
+  EXPECT_THROW(detector.detect(vision::ImageView::of(small)), InputError);
+}
+
 }  // namespace
 }  // namespace lampnav::fusion
