@@ -166,8 +166,13 @@ struct GlobalLocalizer::Impl {
     return out;
   }
 
-  // A lamp's blob centroid wanders over its face when the lamp is near (rad).
-  static double face_sigma(const graph::Lamp& l, double range) { return 0.25 * l.length / range; }
+  // A blob's centroid is not quite the projection of the lamp's centre (the lens bends a near
+  // lamp's face unevenly): a tenth of the lamp's angular size (rad).
+  static double face_sigma(const graph::Lamp& l, double range) { return 0.1 * l.length / range; }
+  // Half the angular size of a lamp's blob (the IR bloom makes it larger than the lamp).
+  static double blob_half_size(const graph::Lamp& l, double range) {
+    return 0.8 * l.length / range;
+  }
 
   // Scores a pose known within (position_sigma, yaw_sigma) and a floor tilt known within
   // tilt_sigma: predicted lamps matched one-to-one to blobs, nearest first, within 3 sigma.
@@ -179,7 +184,7 @@ struct GlobalLocalizer::Impl {
     const double cos_limit = std::cos(std::min(M_PI, max_theta + 0.1));
     struct Predicted {
       Vector3d ray;
-      double theta, sigma;
+      double theta, sigma, half_size;
       int lamp;
       bool crowded = false, matched = false;
     };
@@ -195,13 +200,14 @@ struct GlobalLocalizer::Impl {
       const double pos = position_sigma / range, yaw = yaw_sigma * std::sin(theta);
       const double sigma =
           std::sqrt(det * det + tilt_sigma * tilt_sigma + pos * pos + yaw * yaw + face * face);
-      pred.push_back({ray, theta, sigma, int(i)});
+      pred.push_back({ray, theta, sigma, blob_half_size(*lamps[i], range), int(i)});
     }
-    // Angles between unit rays as chords (|a - b| = 2 sin(angle / 2)): within 1 % of the angle
-    // below 14 degrees, the only angles compared here, and no arc cosine.
+    // Lamps whose blobs merge in the image are not expected on their own. Angles between unit
+    // rays are taken as chords (|a - b| = 2 sin(angle / 2)): within 1 % of the angle below 14
+    // degrees, where it matters, and no arc cosine.
     for (std::size_t a = 0; a < pred.size(); ++a)
       for (std::size_t b = a + 1; b < pred.size(); ++b) {
-        const double limit = 3 * (pred[a].sigma + pred[b].sigma) + 0.02;
+        const double limit = pred[a].half_size + pred[b].half_size + 6 * det + 0.02;
         if ((pred[a].ray - pred[b].ray).squaredNorm() < limit * limit)
           pred[a].crowded = pred[b].crowded = true;
       }
@@ -415,7 +421,7 @@ struct GlobalLocalizer::Impl {
         if (h < 0.2) continue;
         const double s = h / rb.z();
         at[j * nl + i] = mount_t.head<2>() + s * rb.head<2>();
-        const double sj = h * sa / (rb.z() * rb.z()) + 0.5 * lamps[i]->length;
+        const double sj = h * sa / (rb.z() * rb.z()) + 0.1 * lamps[i]->length;
         // A seed that puts the lamp no better than this says nothing of the pose.
         if (sj <= 0.5) sigma[j * nl + i] = sj;
       }

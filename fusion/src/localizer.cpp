@@ -1,6 +1,8 @@
 #include "lampnav/fusion/localizer.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <deque>
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/vision/camera_models.hpp"
@@ -28,7 +30,17 @@ void LocalizerOptions::validate() const {
   kidnap.validate();
   if (omni_check_period < Duration::zero())
     throw InputError({"", "localizer options", "omni_check_period"}, "must not be negative");
+  global.validate();
+  if (omni_update_min_lamps < 0)
+    throw InputError({"", "localizer options", "omni_update_min_lamps"}, "must not be negative");
+  if (!(candidate_sigma_m > 0) || !(candidate_sigma_per_m >= 0) || !(candidate_sigma_yaw_deg > 0))
+    throw InputError({"", "localizer options", "candidate_sigma"}, "must be positive");
 }
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+constexpr Duration kOdometryKept = std::chrono::seconds(120);
+}  // namespace
 
 struct Localizer::Impl {
   const graph::TopologicalMap* map;
@@ -40,7 +52,17 @@ struct Localizer::Impl {
   std::optional<CeilingGeometry> ceiling_geometry;
   std::optional<vision::OmniLampDetector> omni_detector;
   std::optional<OmniCheck> omni_check;
+  std::optional<GlobalLocalizer> global;
   KidnapMonitor monitor;
+  // Dead reckoning in its own frame, kept whatever the filter's state: it carries relocalization
+  // candidates from one omni frame to the next, and a first fix to the latest odometry.
+  std::deque<std::pair<Stamp, Pose2>> odometry;
+  struct Candidate {
+    PoseHypothesis hypothesis;  // score: summed over the frames it was scored on
+    Pose2 odometry;             // dead-reckoned pose at its frame's capture
+  };
+  std::vector<Candidate> candidates;
+  RelocalizationStatus relocalization;
   LocalizerMode mode = LocalizerMode::tracking;
   std::optional<std::pair<double, double>> last_wheels;
   CeilingObservation last_ceiling;
@@ -65,6 +87,7 @@ struct Localizer::Impl {
     if (const CameraDescription* c = robot.find_camera("omni_camera")) {
       omni_detector.emplace(*c, o.omni_detector);
       omni_check.emplace(m, *c, o.omni_check);
+      global.emplace(m, *c, o.global);
     }
   }
 
@@ -81,9 +104,104 @@ struct Localizer::Impl {
     mode = m;
     events.push_back({now(), m, why});
     if (m == LocalizerMode::lost) {
+      candidates.clear();
       if (pipeline) pipeline->reset();  // its labels are worthless
       calibration.forget_measurements();
     }
+  }
+
+  void track_odometry(Stamp stamp, double dl, double dr) {
+    if (!std::isfinite(dl) || !std::isfinite(dr)) return;
+    if (odometry.empty()) {
+      odometry.emplace_back(stamp, Pose2());
+      return;
+    }
+    if (stamp <= odometry.back().first) return;
+    const StateVector x = predict_motion(odometry.back().second.vector(), dl, dr, o.ekf.semi_axis);
+    odometry.emplace_back(stamp, Pose2(x.x(), x.y(), wrap_angle(x.z())));
+    while (odometry.size() > 2 && stamp - odometry.front().first > kOdometryKept)
+      odometry.pop_front();
+  }
+
+  // The dead-reckoned pose at `t`, interpolated; the nearest end outside the kept span.
+  Pose2 odometry_at(Stamp t) const {
+    if (odometry.empty()) return {};
+    auto it = std::lower_bound(odometry.begin(), odometry.end(), t,
+                               [](const auto& a, Stamp s) { return a.first < s; });
+    if (it == odometry.begin()) return it->second;
+    if (it == odometry.end()) return odometry.back().second;
+    const auto& [tb, b] = *it;
+    const auto& [ta, a] = *std::prev(it);
+    const double f = to_seconds(t - ta) / std::max(1e-12, to_seconds(tb - ta));
+    return Pose2(a.translation() + f * (b.translation() - a.translation()),
+                 wrap_angle(a.yaw() + f * wrap_angle(b.yaw() - a.yaw())));
+  }
+
+  // An omni frame while lost (or before any pose): global localization, or the candidates
+  // of earlier frames carried here by odometry and scored again.
+  void relocalize(Stamp stamp, Localizer& self) {
+    ++counts.relocalization_frames;
+    const Pose2 odo = odometry_at(stamp);
+    std::vector<Candidate> next;
+    for (const Candidate& c : candidates) {
+      const Pose2 delta = c.odometry.between(odo);
+      const double travel = delta.translation().norm() + o.ekf.semi_axis * std::abs(delta.yaw());
+      const double sp = o.candidate_sigma_m + o.candidate_sigma_per_m * travel;
+      const double sy = o.candidate_sigma_yaw_deg * kDeg + o.candidate_sigma_per_m * travel;
+      std::optional<PoseHypothesis> h =
+          global->refine(c.hypothesis.pose * delta, sp, sy, last_omni);
+      if (!h) continue;
+      h->score += c.hypothesis.score;
+      next.push_back({std::move(*h), odo});
+    }
+    candidates = std::move(next);
+    if (candidates.empty()) {
+      const GlobalLocalization r = global->locate(last_omni);
+      if (!r.found()) {
+        relocalization = {{}, r.why};
+        return;
+      }
+      // The paper's method names one pose (its argmin); the default one names all that remain.
+      const std::size_t n = r.method == GlobalMethod::paper ? 1 : r.hypotheses.size();
+      for (std::size_t k = 0; k < n; ++k) candidates.push_back({r.hypotheses[k], odo});
+    }
+    std::stable_sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
+      return a.hypothesis.score < b.hypothesis.score;
+    });
+    const double limit = candidates.front().hypothesis.score + o.global.pairs.ambiguity_margin;
+    candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
+                                    [&](const Candidate& c) { return c.hypothesis.score > limit; }),
+                     candidates.end());
+    relocalization.candidates.clear();
+    for (const Candidate& c : candidates) relocalization.candidates.push_back(c.hypothesis);
+    if (candidates.size() > 1) {
+      ++counts.ambiguous_frames;
+      relocalization.why = std::to_string(candidates.size()) +
+                           " poses explain the omni view (a symmetric ceiling): waiting for the "
+                           "next frame to choose";
+      return;
+    }
+    const PoseHypothesis& h = candidates.front().hypothesis;
+    Eigen::Matrix3d P = h.covariance;
+    P.diagonal() += Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, std::pow(0.5 * kDeg, 2));
+    candidates.clear();
+    relocalization.why.clear();
+    self.global_fix({stamp, h.pose, P, "omni"});
+  }
+
+  // While tracking: the omni frame's lamps, matched near the estimate, as a pose measurement.
+  void omni_update(Stamp stamp, const FilterState& prior) {
+    const double sp = std::clamp(std::sqrt(std::max(prior.P(0, 0), prior.P(1, 1))), 0.05, 0.5);
+    const double sy = std::clamp(std::sqrt(prior.P(2, 2)), 0.5 * kDeg, 5 * kDeg);
+    const std::optional<PoseHypothesis> h = global->refine(prior.pose(), sp, sy, last_omni);
+    if (!h || int(h->matches.size()) < o.omni_update_min_lamps || h->missing > h->expected / 2)
+      return;
+    // The least-squares covariance knows detection noise only; floor bumps add to it.
+    Eigen::Matrix3d R = h->covariance;
+    R.diagonal() += Eigen::Vector3d(0.06 * 0.06, 0.06 * 0.06, std::pow(0.15 * kDeg, 2));
+    const UpdateResult u = ekf.update(stamp, h->pose, R);
+    if (u.applied() || u.status == UpdateResult::Status::pending) ++counts.omni_updates;
+    if (u.applied() || u.refusal == Refusal::gated) lose(monitor.innovation(u.mahalanobis2));
   }
 
   void lose(const std::optional<std::string>& why) {
@@ -181,9 +299,11 @@ std::optional<Refusal> Localizer::wheels(Stamp stamp, double left, double right)
   const double dl = left - left0, dr = right - right0;
   const auto [cl, cr] = m.calibration.correct(dl, dr);
   const auto r = m.ekf.predict(stamp, cl, cr);
-  if (!r) {
+  if (!r || *r == Refusal::not_initialized) {
+    // Before the first pose the readings still count: relocalization dead-reckons with them.
     m.last_wheels = {left, right};
-    m.calibration.wheels(stamp, dl, dr);
+    if (!r) m.calibration.wheels(stamp, dl, dr);
+    m.track_odometry(stamp, cl, cr);
   } else if (*r == Refusal::wheel_jump) {
     // An encoder glitch or reset: the jump is not motion; measure from the new reading on.
     m.last_wheels = {left, right};
@@ -232,7 +352,10 @@ const vision::OmniDetection& Localizer::omni_frame(Stamp stamp, const vision::Im
   m.last_omni = m.omni_detector->detect(image);
   m.last_omni_stamp = stamp;
   ++m.counts.omni_frames;
-  if (m.mode == LocalizerMode::lost) return m.last_omni;
+  if (m.mode == LocalizerMode::lost || !m.ekf.initialized()) {
+    m.relocalize(stamp, *this);
+    return m.last_omni;
+  }
   if (m.last_omni_check && stamp - *m.last_omni_check < m.o.omni_check_period) return m.last_omni;
   const std::optional<FilterState> prior = prior_at(stamp);
   if (!prior) return m.last_omni;
@@ -242,6 +365,11 @@ const vision::OmniDetection& Localizer::omni_frame(Stamp stamp, const vision::Im
     m.set_mode(LocalizerMode::tracking,
                "the omnidirectional view agrees with the relocalized pose");
   m.lose(m.monitor.omni(r));
+  if (m.mode == LocalizerMode::lost) {
+    m.relocalize(stamp, *this);  // the frame that showed the loss shows where the robot is
+  } else if (r.conclusive && r.consistent && m.o.omni_update_min_lamps > 0) {
+    m.omni_update(stamp, *prior);
+  }
   return m.last_omni;
 }
 
@@ -250,7 +378,14 @@ bool Localizer::global_fix(const GlobalFix& fix) {
   ++m.counts.global_fixes;
   if (!m.ekf.initialized()) {
     try {
-      m.ekf.initialize(fix.stamp, fix.pose, fix.covariance);
+      // The odometry read since the fix's capture moves it to the latest reading.
+      Stamp at = fix.stamp;
+      Pose2 pose = fix.pose;
+      if (!m.odometry.empty() && m.odometry.back().first > fix.stamp) {
+        at = m.odometry.back().first;
+        pose = fix.pose * m.odometry_at(fix.stamp).between(m.odometry.back().second);
+      }
+      m.ekf.initialize(at, pose, fix.covariance);
     } catch (const InputError&) {
       ++m.counts.fixes_refused;
       return false;
@@ -284,6 +419,7 @@ const vision::OmniDetection* Localizer::last_omni() const {
   return impl_->counts.omni_frames > 0 ? &impl_->last_omni : nullptr;
 }
 Stamp Localizer::last_omni_stamp() const { return impl_->last_omni_stamp; }
+const RelocalizationStatus& Localizer::relocalization() const { return impl_->relocalization; }
 const std::vector<LocalizerEvent>& Localizer::events() const { return impl_->events; }
 const LocalizerCounts& Localizer::counts() const { return impl_->counts; }
 const KidnapMonitor::Counts& Localizer::kidnap_counts() const { return impl_->monitor.counts(); }

@@ -126,8 +126,8 @@ graph::TopologicalMap symmetric_hall() {
   int k = 0;
   for (double x : {-4.0, 0.0, 4.0})
     for (double y : {-2.0, 2.0}) {
-      lamps += std::string(k ? ", " : "") + R"({"id": "L)" + std::to_string(k) +
-               R"(", "xyz": [)" + std::to_string(x) + ", " + std::to_string(y) +
+      lamps += std::string(k ? ", " : "") + R"({"id": "L)" + std::to_string(k) + R"(", "xyz": [)" +
+               std::to_string(x) + ", " + std::to_string(y) +
                R"(, 6.0], "shape": "disc", "size": [0.4]})";
       ++k;
     }

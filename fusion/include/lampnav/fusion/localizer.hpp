@@ -9,6 +9,11 @@
 // the robot: relocalization is requested, camera measurements are not applied), relocalized (a
 // global fix re-initialized the filter; the first accepted ceiling measurement, or a consistent
 // omni check, confirms it and the mode returns to tracking).
+//
+// Relocalization: while lost (or before any pose is known), each omni frame goes to the global
+// localizer. One hypothesis is a fix at once. Several (a symmetric ceiling) are kept as
+// candidates, each carried to the next omni frame by odometry and scored again there; when one
+// stands clearly ahead of the others it becomes the fix.
 
 #include <Eigen/Core>
 #include <memory>
@@ -20,6 +25,7 @@
 #include "lampnav/core/time.hpp"
 #include "lampnav/fusion/ceiling_pipeline.hpp"
 #include "lampnav/fusion/ekf.hpp"
+#include "lampnav/fusion/global_localizer.hpp"
 #include "lampnav/fusion/kidnap_monitor.hpp"
 #include "lampnav/fusion/odometry_calibration.hpp"
 #include "lampnav/graph/map.hpp"
@@ -39,6 +45,13 @@ struct LocalizerOptions {
   OmniCheckOptions omni_check;
   KidnapMonitorOptions kidnap;
   Duration omni_check_period = std::chrono::seconds(1);  // the low-rate omni check
+  GlobalLocalizerOptions global;                         // relocalization from omni frames
+  // While tracking, a consistent omni frame refines the estimate's pose on the lamps it matched
+  // and is applied as a measurement (at least this many lamps; 0 turns it off).
+  int omni_update_min_lamps = 4;
+  // Odometry drift allowed when carrying a candidate to the next omni frame.
+  double candidate_sigma_m = 0.15, candidate_sigma_per_m = 0.05;
+  double candidate_sigma_yaw_deg = 3.0;
   void validate() const;
 };
 
@@ -71,7 +84,16 @@ struct LocalizerCounts {
   std::uint64_t frames_while_lost = 0;  // processed for evidence only
   std::uint64_t measurements_applied = 0, measurements_refused = 0;
   std::uint64_t fixes_refused = 0;
-  std::uint64_t wheel_rebaselined = 0;  // after a refused jump, the new reading is the baseline
+  std::uint64_t wheel_rebaselined = 0;      // after a refused jump, the new reading is the baseline
+  std::uint64_t relocalization_frames = 0;  // omni frames given to the global localizer
+  std::uint64_t ambiguous_frames = 0;       // of those, with several candidates left
+  std::uint64_t omni_updates = 0;           // omni pose measurements applied while tracking
+};
+
+// Where relocalization stands: the candidates kept and why the last frame did not settle it.
+struct RelocalizationStatus {
+  std::vector<PoseHypothesis> candidates;  // at the last omni frame, best first
+  std::string why;                         // why there is no fix yet ("" once fixed)
 };
 
 class Localizer {
@@ -106,7 +128,8 @@ class Localizer {
   std::optional<FilterState> prior_at(Stamp stamp) const;
   LocalizerMode mode() const;
   bool relocalization_requested() const { return mode() == LocalizerMode::lost; }
-  // The latest omni detection and its capture stamp (for the global localizer).
+  const RelocalizationStatus& relocalization() const;
+  // The latest omni detection and its capture stamp.
   const vision::OmniDetection* last_omni() const;
   Stamp last_omni_stamp() const;
   // Mode changes with their reasons, in order.
