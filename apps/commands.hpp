@@ -18,6 +18,7 @@ using Job = std::function<int()>;
 void add_map_commands(CLI::App& app, Job& run);
 void add_route_command(CLI::App& app, Job& run);
 void add_sim_command(CLI::App& app, Job& run);
+void add_locate_command(CLI::App& app, Job& run);
 
 // Prints a diagnostic line to stderr: "lampnav: <kind>: <text>".
 void diagnostic(const std::string& kind, const std::string& text);

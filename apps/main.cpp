@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   apps::add_map_commands(app, run);
   apps::add_route_command(app, run);
   apps::add_sim_command(app, run);
+  apps::add_locate_command(app, run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -538,6 +538,7 @@ struct GlobalLocalizer::Impl {
     }
     for (auto& h : kept) h.weight /= total;
     out.hypotheses = std::move(kept);
+    out.plausible = plausible;
     out.ambiguous = plausible > 1;
     if (out.ambiguous) {
       std::ostringstream why;
@@ -671,7 +672,11 @@ struct GlobalLocalizer::Impl {
       h.node = node_of(q.pose);
       out.hypotheses.push_back(std::move(h));
     }
-    for (auto& h : out.hypotheses) h.weight = 1.0 / out.hypotheses.size();
+    for (auto& h : out.hypotheses) h.weight = 0;
+    if (!out.hypotheses.empty()) {
+      out.hypotheses.front().weight = 1;
+      out.plausible = 1;
+    }
     return out;
   }
 };

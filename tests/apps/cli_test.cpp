@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 
+#include "lampnav/io/mission_log.hpp"
 #include "lampnav_test.hpp"
 
 namespace lampnav {
@@ -152,6 +154,77 @@ TEST(Cli, SimRecordsARouteAndRefusesBadInput) {
   EXPECT_THAT(bad_lamp.err, HasSubstr("no lamp 'NOPE'"));
   const Result both = run("sim -o x.mcap");
   EXPECT_EQ(both.status, 2);
+}
+
+// The fixture: the museum seen from (8.0, -2.5) facing 34.4 degrees (0.6 rad), floor tilted by
+// (0.23, -0.34) degrees, rendered by sim::OmniRenderer without pixel noise.
+std::string locate_args(const std::string& image) {
+  return "locate --map " + src("maps/domus_museum.geojson") + " --robot " +
+         src("maps/robots/pioneer.json") + " --image " + image;
+}
+
+TEST(Cli, LocateFindsThePoseAndItsNode) {
+  for (const char* method : {"default", "paper"}) {
+    const Result r = run(locate_args(src("tests/fixtures/images/domus_omni.png")) +
+                         " --json --method " + method);
+    ASSERT_EQ(r.status, 0) << r.err;
+    EXPECT_EQ(r.err, "");
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["method"], method);
+    ASSERT_FALSE(j["hypotheses"].empty());
+    const auto& best = j["hypotheses"][0];
+    const double tol = std::string(method) == "paper" ? 1.0 : 0.1;
+    EXPECT_NEAR(best["x"].get<double>(), 8.0, tol);
+    EXPECT_NEAR(best["y"].get<double>(), -2.5, tol);
+    EXPECT_NEAR(best["yaw_deg"].get<double>(), 34.38, 5.0);
+    EXPECT_EQ(best["node"], "E");
+    EXPECT_GE(best["matches"].size(), 10u);
+    EXPECT_TRUE(best["matches"][0].contains("lamp"));
+  }
+  const Result text = run(locate_args(src("tests/fixtures/images/domus_omni.png")));
+  EXPECT_EQ(text.status, 0);
+  EXPECT_THAT(text.out, HasSubstr("1 plausible"));
+  EXPECT_THAT(text.out, HasSubstr("lamps of 1:"));
+}
+
+TEST(Cli, LocateSaysWhyWhenThereIsNoPoseOrTheInputIsBad) {
+  const auto dir = std::filesystem::temp_directory_path();
+  auto write = [&](const std::string& name, const Image8& img) {
+    const auto path = dir / (name + std::to_string(::getpid()) + ".png");
+    std::ofstream(path, std::ios::binary) << io::encode_png(img);
+    return path.string();
+  };
+  const std::string dark = write("lampnav_dark_", Image8(1024, 1024, 6));
+  const std::string small = write("lampnav_small_", Image8(640, 480, 6));
+  const std::string text = (dir / ("lampnav_text_" + std::to_string(::getpid()) + ".png")).string();
+  std::ofstream(text) << "not an image";
+  // No lamp: the job ran and failed.
+  const Result none = run(locate_args("'" + dark + "'"));
+  EXPECT_EQ(none.status, 1);
+  EXPECT_THAT(none.err, HasSubstr("no hypothesis: no lamp in the image"));
+  EXPECT_EQ(none.out, "");
+  // Bad input: exit 2, naming the file and the problem.
+  const Result wrong = run(locate_args("'" + small + "'"));
+  EXPECT_EQ(wrong.status, 2);
+  EXPECT_THAT(wrong.err, HasSubstr(small));
+  EXPECT_THAT(wrong.err, HasSubstr("640"));
+  const Result garbage = run(locate_args("'" + text + "'"));
+  EXPECT_EQ(garbage.status, 2);
+  EXPECT_THAT(garbage.err, HasSubstr("does not decode"));
+  const Result missing = run(locate_args("/nonexistent.png"));
+  EXPECT_EQ(missing.status, 2);
+  EXPECT_THAT(missing.err, HasSubstr("/nonexistent.png"));
+  const std::string fixture = src("tests/fixtures/images/domus_omni.png");
+  const Result method = run(locate_args(fixture) + " --method best");
+  EXPECT_EQ(method.status, 2);
+  EXPECT_THAT(method.err, HasSubstr("'best' is not a method"));
+  const Result camera = run(locate_args(fixture) + " --camera ceiling_camera");
+  EXPECT_EQ(camera.status, 2);
+  EXPECT_THAT(camera.err, HasSubstr("pajdla_bakstein"));
+  const Result nocam = run(locate_args(fixture) + " --camera nope");
+  EXPECT_EQ(nocam.status, 2);
+  EXPECT_THAT(nocam.err, HasSubstr("no camera named 'nope'"));
+  for (const auto& f : {dark, small, text}) std::filesystem::remove(f);
 }
 
 }  // namespace

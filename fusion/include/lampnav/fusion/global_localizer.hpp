@@ -97,6 +97,7 @@ struct PoseHypothesis {
 struct GlobalLocalization {
   GlobalMethod method = GlobalMethod::lamp_pairs;
   std::vector<PoseHypothesis> hypotheses;  // best first
+  int plausible = 0;       // hypotheses within the ambiguity margin of the best (first ones)
   bool ambiguous = false;  // several distinct poses explain the image (symmetric ceiling)
   std::string why;         // why there is no hypothesis, or why it is ambiguous
   int blobs = 0;           // detections used
