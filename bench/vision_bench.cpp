@@ -1,6 +1,8 @@
 // Ceiling-frame lamp detection and tracking on 352x288 frames of a simulated corridor drive, side
 // by side with OpenCV's SimpleBlobDetector and ViSP's vpDot2::searchDotsInArea on the same frames.
 // Target (issue 4): detection plus tracking at most 200 us per frame on one core.
+// Omnidirectional lamp detection on 1024x1024 museum frames: ours (connected components) against
+// paper 1's pipeline as published (threshold, dilation, Canny, contours) on OpenCV.
 
 #include <benchmark/benchmark.h>
 
@@ -12,6 +14,8 @@
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/sim/renderers.hpp"
 #include "lampnav/vision/lamp_tracker.hpp"
+#include "lampnav/vision/omni_detector.hpp"
+#include "paper_omni_pipeline.hpp"
 
 namespace {
 
@@ -123,4 +127,51 @@ void BM_VispSearchDotsInArea(benchmark::State& state) {
 BENCHMARK(BM_VispSearchDotsInArea)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
+// Ten museum views, floor bumps on, people and spurious lights as the simulator draws them.
+struct OmniFrames {
+  RobotDescription robot;
+  std::vector<Image8> images;
+  OmniFrames() {
+    const std::string src = LAMPNAV_SOURCE_DIR;
+    robot = read_robot_description(src + "/maps/robots/pioneer.json");
+    const auto map = graph::read_map(src + "/maps/domus_museum.geojson").map;
+    std::vector<const graph::Lamp*> lamps;
+    for (const auto& n : map.nodes())
+      for (const auto& l : n.lamps) lamps.push_back(&l);
+    const sim::OmniRenderer renderer(*robot.find_camera("omni_camera"), {});
+    std::mt19937_64 rng(4);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::normal_distribution<double> bump(0, 0.5 * M_PI / 180);
+    for (int k = 0; k < 10; ++k)
+      images.push_back(renderer.render(Pose2(-2 + 24 * u(rng), -9 + 11 * u(rng), 6.28 * u(rng)),
+                                       {bump(rng), bump(rng)}, lamps, rng));
+  }
+};
+
+const OmniFrames& omni_frames() {
+  static const OmniFrames f;
+  return f;
+}
+
+void BM_OmniDetector(benchmark::State& state) {
+  const OmniFrames& f = omni_frames();
+  vision::OmniLampDetector det(*f.robot.find_camera("omni_camera"));
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const auto d = det.detect(vision::ImageView::of(f.images[k++ % f.images.size()]));
+    benchmark::DoNotOptimize(d.blobs.data());
+  }
+}
+BENCHMARK(BM_OmniDetector)->Unit(benchmark::kMicrosecond);
+
+void BM_PaperOmniPipelineOpenCv(benchmark::State& state) {
+  const OmniFrames& f = omni_frames();
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const auto blobs = test::paper_omni_pipeline(f.images[k++ % f.images.size()]);
+    benchmark::DoNotOptimize(blobs.data());
+  }
+}
+BENCHMARK(BM_PaperOmniPipelineOpenCv)->Unit(benchmark::kMicrosecond);
+
 BENCHMARK_MAIN();
