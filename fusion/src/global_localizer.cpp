@@ -102,6 +102,56 @@ struct Tilt {
   }
 };
 
+// The paper method's random numbers: xoshiro256** seeded by splitmix64, and Gaussians by
+// Marsaglia's polar method. Several times cheaper than mt19937_64 with std::normal_distribution,
+// which took a tenth of the method's time; the same seed gives the same poses everywhere.
+class ParticleRandom {
+ public:
+  explicit ParticleRandom(std::uint64_t seed) {
+    for (auto& w : s_) {
+      seed += 0x9e3779b97f4a7c15ULL;
+      std::uint64_t z = seed;
+      z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+      z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+      w = z ^ (z >> 31);
+    }
+  }
+  double uniform() { return double(next() >> 11) * 0x1.0p-53; }  // [0, 1)
+  double gaussian() {
+    if (spare_) {
+      spare_ = false;
+      return spare_value_;
+    }
+    double u, v, q;
+    do {
+      u = 2 * uniform() - 1;
+      v = 2 * uniform() - 1;
+      q = u * u + v * v;
+    } while (q >= 1 || q == 0);
+    const double f = std::sqrt(-2 * std::log(q) / q);
+    spare_value_ = v * f;
+    spare_ = true;
+    return u * f;
+  }
+
+ private:
+  static std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+  std::uint64_t next() {
+    const std::uint64_t result = rotl(s_[1] * 5, 7) * 9;
+    const std::uint64_t t = s_[1] << 17;
+    s_[2] ^= s_[0];
+    s_[3] ^= s_[1];
+    s_[1] ^= s_[2];
+    s_[0] ^= s_[3];
+    s_[2] ^= t;
+    s_[3] = rotl(s_[3], 45);
+    return result;
+  }
+  std::uint64_t s_[4];
+  bool spare_ = false;
+  double spare_value_ = 0;
+};
+
 bool distinct(const Pose2& a, const Pose2& b, double metres, double degrees) {
   return (a.translation() - b.translation()).norm() > metres ||
          std::abs(wrap_angle(a.yaw() - b.yaw())) > degrees * kDeg;
@@ -551,9 +601,8 @@ struct GlobalLocalizer::Impl {
   // ---------------------------------------------------------------------------------------
   // Method `paper` (Alg. 3).
 
-  Pose2 uniform_pose(std::mt19937_64& rng) const {
-    std::uniform_real_distribution<double> u(0.0, 1.0);
-    const double yaw = wrap_angle(2 * M_PI * u(rng) - M_PI);
+  Pose2 uniform_pose(ParticleRandom& rng) const {
+    const double yaw = wrap_angle(2 * M_PI * rng.uniform() - M_PI);
     if (!has_regions) {
       // No regions: the box around the lamps.
       Vector2d lo = lamps.front()->xyz.head<2>(), hi = lo;
@@ -561,17 +610,18 @@ struct GlobalLocalizer::Impl {
         lo = lo.cwiseMin(l->xyz.head<2>());
         hi = hi.cwiseMax(l->xyz.head<2>());
       }
-      return Pose2(lo.x() + u(rng) * (hi.x() - lo.x()), lo.y() + u(rng) * (hi.y() - lo.y()), yaw);
+      return Pose2(lo.x() + rng.uniform() * (hi.x() - lo.x()),
+                   lo.y() + rng.uniform() * (hi.y() - lo.y()), yaw);
     }
-    const double a = u(rng) * region_cdf.back();
+    const double a = rng.uniform() * region_cdf.back();
     const std::size_t k = std::min<std::size_t>(
         std::lower_bound(region_cdf.begin(), region_cdf.end(), a) - region_cdf.begin(),
         regions.size() - 1);
     const graph::Polygon& poly = regions[k]->region;
     const auto box = poly.bounds();
     for (int tries = 0; tries < 1000; ++tries) {
-      const Vector2d p(box.min.x() + u(rng) * (box.max.x() - box.min.x()),
-                       box.min.y() + u(rng) * (box.max.y() - box.min.y()));
+      const Vector2d p(box.min.x() + rng.uniform() * (box.max.x() - box.min.x()),
+                       box.min.y() + rng.uniform() * (box.max.y() - box.min.y()));
       if (poly.contains(p)) return Pose2(p, yaw);
     }
     return Pose2(poly.centroid(), yaw);
@@ -587,7 +637,7 @@ struct GlobalLocalizer::Impl {
       return out;
     }
     const MeritFunction merit = merit_function(d);
-    std::mt19937_64 rng(p.seed);
+    ParticleRandom rng(p.seed);
     struct Particle {
       Pose2 pose;
       Merit m;
@@ -607,10 +657,10 @@ struct GlobalLocalizer::Impl {
     for (Particle& q : set) q.pose = uniform_pose(rng);
     evaluate_all(set);
     set.resize(p.particles);
-    std::normal_distribution<double> n_xy(0, p.noise_xy_m), n_yaw(0, p.noise_yaw_deg * kDeg);
+    const double s_xy = p.noise_xy_m, s_yaw = p.noise_yaw_deg * kDeg;
     auto spawn = [&](const Pose2& parent) {
-      return Particle{Pose2(parent.x() + n_xy(rng), parent.y() + n_xy(rng),
-                            wrap_angle(parent.yaw() + n_yaw(rng))),
+      return Particle{Pose2(parent.x() + s_xy * rng.gaussian(), parent.y() + s_xy * rng.gaussian(),
+                            wrap_angle(parent.yaw() + s_yaw * rng.gaussian())),
                       {}};
     };
     const int n_best = static_cast<int>(std::lround(p.best_fraction * p.particles));

@@ -49,8 +49,11 @@ CeilingMapProjection::CeilingMapProjection(const graph::TopologicalMap& map,
 
 void CeilingMapProjection::project(const Pose2& robot, std::vector<Vector2d>& pixels,
                                    std::vector<int>* lamp) const {
-  pixels.clear();
-  if (lamp) lamp->clear();
+  // Sized for every lamp, then cut to those in view: no capacity check per pixel.
+  pixels.resize(lamps_.size());
+  if (lamp) lamp->resize(lamps_.size());
+  Vector2d* out = pixels.data();
+  std::size_t n = 0;
   const double c = std::cos(robot.yaw()), s = std::sin(robot.yaw());
   // World -> camera: R = mount^T Rz(-yaw), camera centre C = (x, y, 0) + Rz(yaw) mount_t.
   Eigen::Matrix3d Rz_t;
@@ -83,9 +86,12 @@ void CeilingMapProjection::project(const Pose2& robot, std::vector<Vector2d>& pi
     const float g = (g_table_[k] + (q - k) * (g_table_[k + 1] - g_table_[k])) * inv;
     const float u = u0 + g * vx, v = v0 + beta * g * vy;
     if (u < -0.5f || v < -0.5f || u > w || v > h) continue;
-    pixels.emplace_back(u, v);
-    if (lamp) lamp->push_back(static_cast<int>(i));
+    out[n] = Vector2d(u, v);
+    if (lamp) (*lamp)[n] = static_cast<int>(i);
+    ++n;
   }
+  pixels.resize(n);
+  if (lamp) lamp->resize(n);
 }
 
 MeritFunction::MeritFunction(std::vector<Vector2d> detected, double threshold, int width,

@@ -64,9 +64,13 @@ struct Errors {
   }
 };
 
-// Records a Domus scenario and localizes every omni image of it with both methods.
-std::pair<Errors, Errors> run_domus(const std::string& scenario, double bump_deg,
-                                    std::uint64_t seed) {
+// A Domus scenario recorded, its omni images detected, with the truth at each capture.
+struct DomusRun {
+  std::vector<vision::OmniDetection> detections;
+  std::vector<Pose2> truth;
+};
+
+DomusRun record_domus(const std::string& scenario, double bump_deg, std::uint64_t seed) {
   const Museum m;
   sim::Scenario s = sim::make_named_scenario(scenario, m.map, m.geojson, m.robot, seed);
   s.bump_sigma_rad = bump_deg * M_PI / 180;
@@ -80,16 +84,31 @@ std::pair<Errors, Errors> run_domus(const std::string& scenario, double bump_deg
   std::sort(truth.begin(), truth.end(),
             [](const auto& a, const auto& b) { return a.value.stamp < b.value.stamp; });
   vision::OmniLampDetector detector(m.cam());
-  const GlobalLocalizer global(m.map, m.cam());
-  Errors paper, ours;
+  DomusRun run;
   for (const auto& f : log.omni_images) {
     const Image8 img = io::decode_image(f.value.data, "omni frame");
-    const vision::OmniDetection d = detector.detect(vision::ImageView::of(img));
-    const Pose2 t = test::truth_at(truth, f.value.stamp);
-    paper.add(global.locate(d, GlobalMethod::paper), t, m.map);
-    ours.add(global.locate(d, GlobalMethod::lamp_pairs), t, m.map);
+    run.detections.push_back(detector.detect(vision::ImageView::of(img)));
+    run.truth.push_back(test::truth_at(truth, f.value.stamp));
   }
-  return {paper, ours};
+  return run;
+}
+
+Errors localize_all(const DomusRun& run, GlobalMethod method, std::uint64_t paper_seed = 1) {
+  const Museum m;
+  GlobalLocalizerOptions o;
+  o.paper.seed = paper_seed;
+  const GlobalLocalizer global(m.map, m.cam(), o);
+  Errors e;
+  for (std::size_t k = 0; k < run.detections.size(); ++k)
+    e.add(global.locate(run.detections[k], method), run.truth[k], m.map);
+  return e;
+}
+
+// Both methods on one scenario.
+std::pair<Errors, Errors> run_domus(const std::string& scenario, double bump_deg,
+                                    std::uint64_t seed) {
+  const DomusRun run = record_domus(scenario, bump_deg, seed);
+  return {localize_all(run, GlobalMethod::paper), localize_all(run, GlobalMethod::lamp_pairs)};
 }
 
 TEST(GlobalLocalizer, DomusGlobalRun) {
@@ -110,6 +129,24 @@ TEST(GlobalLocalizer, DomusKidnapRun) {
   EXPECT_EQ(ours.found, ours.images);
   EXPECT_LE(ours.max_pos, 0.6);
   EXPECT_LE(ours.max_yaw, 5.0);
+}
+
+// The paper's method is a random search: its figures depend on the draw. Five seeds on the
+// global run show the spread; each locates every image, and on average it does no worse than
+// the paper reports (0.53 m, 3 degrees).
+TEST(GlobalLocalizer, PaperMethodOverSeeds) {
+  const DomusRun run = record_domus("domus-global", 0.5, 1);
+  double sum_mean = 0, worst = 0;
+  for (std::uint64_t seed = 1; seed <= 5; ++seed) {
+    const Errors e = localize_all(run, GlobalMethod::paper, seed);
+    std::cout << "domus-global, paper, seed " << seed << ": " << e.summary() << "\n";
+    EXPECT_EQ(e.found, e.images);
+    sum_mean += e.mean_pos() / 5;
+    worst = std::max(worst, e.max_pos);
+    EXPECT_LE(e.mean_yaw(), 3.0);
+  }
+  std::cout << "paper over 5 seeds: position mean " << sum_mean << " m, worst " << worst << " m\n";
+  EXPECT_LE(sum_mean, 0.6);  // the paper: 0.53
 }
 
 TEST(GlobalLocalizer, DomusGlobalRunWithoutBumps) {
