@@ -126,7 +126,6 @@ void BM_VispSearchDotsInArea(benchmark::State& state) {
 }
 BENCHMARK(BM_VispSearchDotsInArea)->Unit(benchmark::kMicrosecond);
 
-}  // namespace
 // Ten museum views, floor bumps on, people and spurious lights as the simulator draws them.
 struct OmniFrames {
   RobotDescription robot;
@@ -173,5 +172,7 @@ void BM_PaperOmniPipelineOpenCv(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_PaperOmniPipelineOpenCv)->Unit(benchmark::kMicrosecond);
+
+}  // namespace
 
 BENCHMARK_MAIN();

@@ -32,19 +32,27 @@ struct Museum {
     ro.spurious_per_image = 0;
     return sim::OmniRenderer(cam, ro);
   }
+  // `n` clean views from random poses in halls E and A.
+  std::vector<std::pair<Pose2, Image8>> random_views(std::uint64_t seed, int n) const {
+    const sim::OmniRenderer renderer = clean_renderer();
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(0, 1);
+    std::vector<std::pair<Pose2, Image8>> out;
+    for (int k = 0; k < n; ++k) {
+      const Pose2 pose(-2 + 24 * u(rng), -9 + 11 * u(rng), 2 * M_PI * u(rng));
+      out.emplace_back(pose, renderer.render(pose, {}, lamps(), rng));
+    }
+    return out;
+  }
 };
 
 TEST(OmniLampDetector, FindsEveryLampInViewAtItsProjection) {
   Museum m;
   const sim::OmniRenderer renderer = m.clean_renderer();
   OmniLampDetector det(m.cam);
-  std::mt19937_64 rng(5);
-  std::uniform_real_distribution<double> u(0, 1);
   int expected = 0, found = 0;
   double worst = 0;
-  for (int k = 0; k < 30; ++k) {
-    const Pose2 pose(-2 + 24 * u(rng), -9 + 11 * u(rng), 2 * M_PI * u(rng));
-    const Image8 img = renderer.render(pose, {}, m.lamps(), rng);
+  for (const auto& [pose, img] : m.random_views(5, 30)) {
     const OmniDetection d = det.detect(ImageView::of(img));
     EXPECT_FALSE(d.flooded);
     for (const auto* l : m.lamps()) {
@@ -144,15 +152,10 @@ TEST(OmniLampDetector, BlackSpecksAndWrongImages) {
 // differs by a fraction of a pixel) where lamps stand apart. Speed: bench/vision_bench.
 TEST(OmniLampDetector, EquivalentToThePapersContourPipeline) {
   Museum m;
-  const sim::OmniRenderer renderer = m.clean_renderer();
   OmniLampDetector det(m.cam);
-  std::mt19937_64 rng(8);
-  std::uniform_real_distribution<double> u(0, 1);
   int compared = 0, unmatched = 0;
   double worst = 0;
-  for (int k = 0; k < 30; ++k) {
-    const Pose2 pose(-2 + 24 * u(rng), -9 + 11 * u(rng), 2 * M_PI * u(rng));
-    const Image8 img = renderer.render(pose, {}, m.lamps(), rng);
+  for (const auto& [pose, img] : m.random_views(8, 30)) {
     const OmniDetection d = det.detect(ImageView::of(img));
     const auto paper = test::paper_omni_pipeline(img);
     for (const OmniBlob& b : d.blobs) {
