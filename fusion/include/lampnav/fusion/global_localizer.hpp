@@ -34,9 +34,9 @@ const char* to_string(GlobalMethod method);
 std::optional<GlobalMethod> parse_global_method(const std::string& name);
 
 // Alg. 3 as published. The paper gives neither the matching threshold nor the noise; ours are
-// the noise of about the spacing of the 702 initial poses over the museum (0.9 m) and a threshold
-// of 40 px (8 degrees near the axis), chosen among 25-40 px and 0.3-0.6 m on the simulated global
-// run (docs/global-localization.md). The published count of 2502 evaluations is 702 + 6 x 300:
+// noise of about the spacing of the 702 initial poses over the museum's regions (0.83 m) and a
+// threshold of 25 px, chosen among 15-40 px and 0.3-0.6 m on the simulated global run within
+// the 2 ms budget (docs/global-localization.md). The published count of 2502 evaluations is 702 + 6 x 300:
 // each iteration evaluates the 200 new poses with the best half of the particles they came from.
 struct PaperMethodOptions {
   int initial_poses = 702;

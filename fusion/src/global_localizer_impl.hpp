@@ -1,0 +1,156 @@
+#pragma once
+// The global localizer's private parts, shared by its sources: global_localizer.cpp (options,
+// scoring a pose against the blobs, least squares, ranking, the API), lamp_pairs.cpp (method
+// `default`) and paper_method.cpp (method `paper`, Alg. 3).
+
+#include <Eigen/Core>
+#include <cmath>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "lampnav/fusion/global_localizer.hpp"
+#include "lampnav/fusion/merit.hpp"
+#include "lampnav/vision/camera_models.hpp"
+
+namespace lampnav::fusion {
+namespace detail {
+
+using Eigen::Matrix3d;
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+constexpr double kDeg = M_PI / 180.0;
+
+struct BlobRay {
+  Vector3d ray;  // camera frame
+  double theta, angular_radius;
+  int index;  // into the detection's blobs
+};
+
+// One pose scored against the blobs.
+struct Evaluation {
+  double cost = std::numeric_limits<double>::infinity();
+  int expected = 0, missing = 0, unexplained = 0;
+  std::vector<std::pair<int, int>> matches;  // (lamp index, blob index into BlobRay list)
+};
+
+// The floor's tilt of the base (rad), a nuisance estimated with each pose.
+struct Tilt {
+  double roll = 0, pitch = 0;
+  // body^T without yaw: Rx(-roll) Ry(-pitch), and its derivatives by roll and pitch.
+  Matrix3d inverse_rotation() const { return rx() * ry(); }
+  std::pair<Matrix3d, Matrix3d> inverse_rotation_derivatives() const {
+    const double cr = std::cos(roll), sr = std::sin(roll);
+    const double cp = std::cos(pitch), sp = std::sin(pitch);
+    Matrix3d dRx, dRy;
+    dRx << 0, 0, 0, 0, -sr, cr, 0, -cr, -sr;
+    dRy << -sp, 0, -cp, 0, 0, 0, cp, 0, -sp;
+    return {dRx * ry(), rx() * dRy};
+  }
+  Matrix3d rx() const {  // Rx(-roll)
+    const double c = std::cos(roll), s = std::sin(roll);
+    Matrix3d R;
+    R << 1, 0, 0, 0, c, s, 0, -s, c;
+    return R;
+  }
+  Matrix3d ry() const {  // Ry(-pitch)
+    const double c = std::cos(pitch), s = std::sin(pitch);
+    Matrix3d R;
+    R << c, 0, -s, 0, 1, 0, s, 0, c;
+    return R;
+  }
+};
+
+class ParticleRandom;  // paper_method.cpp
+
+inline bool distinct(const Pose2& a, const Pose2& b, double metres, double degrees) {
+  return (a.translation() - b.translation()).norm() > metres ||
+         std::abs(wrap_angle(a.yaw() - b.yaw())) > degrees * kDeg;
+}
+
+}  // namespace detail
+
+struct GlobalLocalizer::Impl {
+  using BlobRay = detail::BlobRay;
+  using Evaluation = detail::Evaluation;
+  using Tilt = detail::Tilt;
+  using ParticleRandom = detail::ParticleRandom;
+  using Matrix3d = detail::Matrix3d;
+  using Vector3d = detail::Vector3d;
+
+  const graph::TopologicalMap* map;
+  GlobalLocalizerOptions o;
+  vision::FisheyeCamera model;
+  CeilingMapProjection projection;
+  Matrix3d mount_R, mount_Rt;  // camera -> base, base -> camera
+  Vector3d mount_t;
+  std::vector<const graph::Lamp*> lamps;
+  std::vector<const graph::Node*> regions;  // nodes with a region, for the paper's uniform poses
+  std::vector<double> region_cdf;
+  bool has_regions = false;
+
+  Impl(const graph::TopologicalMap& m, const CameraDescription& camera,
+       const GlobalLocalizerOptions& opt);
+
+  const graph::Node* node_of(const Pose2& p) const { return map->node_containing(p.translation()); }
+
+  // ---------------------------------------------------------------------------------------
+  // Scoring a pose. The lamp in the camera frame from a robot pose, the base tilted by the floor (roll about
+  // x, then pitch about y, as conventions.md orders roll-pitch-yaw).
+  Vector3d camera_point(const Pose2& pose, const Vector3d& lamp, const Tilt& tilt = {}) const;
+
+  std::vector<BlobRay> blob_rays(const vision::OmniDetection& d, double max_theta) const;
+
+  // A blob's centroid is not quite the projection of the lamp's centre (the lens bends a near
+  // lamp's face unevenly): a tenth of the lamp's angular size (rad).
+  static double face_sigma(const graph::Lamp& l, double range) { return 0.1 * l.length / range; }
+  // Half the angular size of a lamp's blob (the IR bloom makes it larger than the lamp).
+  static double blob_half_size(const graph::Lamp& l, double range);
+
+  // Scores a pose known within (position_sigma, yaw_sigma) and a floor tilt known within
+  // tilt_sigma: predicted lamps matched one-to-one to blobs, nearest first, within 3 sigma.
+  Evaluation evaluate(const Pose2& pose, const Tilt& tilt, double position_sigma, double yaw_sigma,
+                      double tilt_sigma, const std::vector<BlobRay>& blobs) const;
+
+  struct Solution {
+    Pose2 pose;
+    Tilt tilt;
+    Matrix3d covariance;  // of the pose, the tilt marginalized
+    Eigen::Matrix2d tilt_covariance;
+    double cost = 0;  // robust sum of squared normalized residuals, plus the tilt's prior
+  };
+
+  // Gauss-Newton on the matched lamps: the pose (and the floor's tilt, with its prior) whose
+  // predicted directions are nearest the seen ones. Tilt and translation both move the lamps in
+  // view, but differently: a tilt turns every ray by the same angle, a translation turns a ray
+  // by less the further off-axis its lamp is; the wide view tells them apart.
+  // Without `with_tilt` the floor is taken as level.
+  Solution solve(Pose2 pose, Tilt tilt, const Evaluation& e, const std::vector<BlobRay>& blobs,
+                 bool with_tilt) const;
+
+  // Refines a pose: match, solve, match again with the tolerance the solution earned.
+  PoseHypothesis refine(Pose2 pose, double position_sigma, double yaw_sigma,
+                        const std::vector<BlobRay>& blobs) const;
+
+  // The paper's merit of a pose, for every hypothesis whatever its method.
+  double paper_merit(const Pose2& pose, const MeritFunction& merit) const;
+
+  MeritFunction merit_function(const vision::OmniDetection& d) const;
+
+  // ---------------------------------------------------------------------------------------
+  // Method `default`.
+  GlobalLocalization lamp_pairs(const vision::OmniDetection& d) const;
+
+  // Ranks, merges near-duplicates, weighs, places on the graph, and says whether it is ambiguous.
+  void finish(GlobalLocalization& out, std::vector<PoseHypothesis> hs,
+              const vision::OmniDetection& d) const;
+
+  // ---------------------------------------------------------------------------------------
+  // Method `paper` (Alg. 3).
+  Pose2 uniform_pose(ParticleRandom& rng) const;
+
+  GlobalLocalization paper(const vision::OmniDetection& d) const;
+};
+
+}  // namespace lampnav::fusion
