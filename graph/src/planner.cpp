@@ -4,7 +4,7 @@
 #include <boost/graph/dijkstra_shortest_paths.hpp>
 #include <cstdio>
 
-#include "corridor_geometry.hpp"
+#include "lampnav/graph/corridor_geometry.hpp"
 #include "lampnav/core/error.hpp"
 #include "map_impl.hpp"
 

@@ -4,7 +4,7 @@
 #include <cctype>
 #include <cmath>
 
-#include "corridor_geometry.hpp"
+#include "lampnav/graph/corridor_geometry.hpp"
 #include "lampnav/graph/geometry.hpp"
 
 namespace lampnav::graph {

@@ -8,6 +8,7 @@
 #include "lampnav/graph/planner.hpp"
 #include "lampnav/graph/route_commands.hpp"
 #include "lampnav/io/mission_log.hpp"
+#include "lampnav/navigation/path_follower.hpp"
 
 namespace lampnav::sim {
 
@@ -323,7 +324,7 @@ RecordStats record_mission(const Scenario& s, const std::string& path,
     }
     stats.arrived = true;
   } else {
-    PathFollower follower(s.waypoints, {s.max_speed, 0.8, 0.6, 0.1});
+    navigation::PathFollower follower(s.waypoints, {s.max_speed, 0.8, 0.6, 0.1});
     const double expected = path_length(s.waypoints) / s.max_speed;
     std::size_t kidnap_index = 0;
     while (!follower.arrived() && t_ns < static_cast<std::int64_t>(s.max_duration_s * 1e9)) {
@@ -345,7 +346,7 @@ RecordStats record_mission(const Scenario& s, const std::string& path,
           }
         }
         if (pts.size() < 2) pts.push_back(s.waypoints.back());
-        follower = PathFollower(pts, {s.max_speed, 0.8, 0.6, 0.1});
+        follower = navigation::PathFollower(pts, {s.max_speed, 0.8, 0.6, 0.1});
       }
       const auto [v, w] = follower.command(pose);
       const WheelTravel travel = wheel_travel(v * dt_ns * 1e-9, w * dt_ns * 1e-9, true_axis);
