@@ -86,13 +86,6 @@ bool operator==(const RouteCommand& a, const RouteCommand& b) {
 
 namespace {
 
-// Where the robot comes from / goes to when it uses node n next to point p: the end of n's axis
-// away from p, or n's own point.
-Vector2d far_anchor(const Node& n, const Vector2d& p) {
-  if (!n.axis) return n.point;
-  return (n.axis->first - p).norm() > (n.axis->second - p).norm() ? n.axis->first : n.axis->second;
-}
-
 Side flipped(Side s) { return s == Side::left ? Side::right : Side::left; }
 
 struct Passed {

@@ -1,5 +1,6 @@
 #pragma once
-// Where a route enters and leaves a corridor, shared by route commands and route waypoints.
+// Where a route enters and leaves a corridor, shared by route commands, route waypoints and the
+// navigation's command interpreter.
 
 #include <algorithm>
 
@@ -25,6 +26,13 @@ inline double meeting_point(const Node& corridor, const Node& other) {
 inline double entry_point(const Node& corridor, const Node* neighbour) {
   if (neighbour) return meeting_point(corridor, *neighbour);
   return std::clamp(corridor.axis->along(corridor.point), 0.0, corridor.axis->length());
+}
+
+// Where the robot comes from / goes to when it uses node n next to point p: the end of n's axis
+// away from p, or n's own point.
+inline Eigen::Vector2d far_anchor(const Node& n, const Eigen::Vector2d& p) {
+  if (!n.axis) return n.point;
+  return (n.axis->first - p).norm() > (n.axis->second - p).norm() ? n.axis->first : n.axis->second;
 }
 
 }  // namespace lampnav::graph
