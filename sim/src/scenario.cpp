@@ -9,6 +9,7 @@
 #include "lampnav/graph/route_commands.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/navigation/path_follower.hpp"
+#include "world.hpp"
 
 namespace lampnav::sim {
 
@@ -159,27 +160,11 @@ Scenario make_named_scenario(const std::string& name, const graph::TopologicalMa
 
 namespace {
 
-// A kidnap without a destination: a random pose along a corridor's axis, or in a hall.
-Pose2 random_place(const graph::TopologicalMap& map, std::mt19937_64& rng) {
-  std::vector<const graph::Node*> candidates;
-  for (const auto& n : map.nodes()) {
-    if ((n.place == graph::Place::corridor && n.axis) || n.place == graph::Place::hall)
-      candidates.push_back(&n);
-  }
-  if (candidates.empty())
-    throw InputError({"", "scenario", "kidnaps"},
-                     "the map has no corridor or hall to put the robot down in");
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  const graph::Node& n =
-      *candidates[static_cast<std::size_t>(u(rng) * candidates.size()) % candidates.size()];
-  if (n.axis) {
-    const Vector2d p = n.axis->point_at((0.15 + 0.7 * u(rng)) * n.axis->length());
-    const double yaw =
-        std::atan2(n.axis->direction().y(), n.axis->direction().x()) + (u(rng) < 0.5 ? 0 : M_PI);
-    return {p, yaw};
-  }
-  const Vector2d c = n.region.centroid();
-  return {c, 2 * M_PI * u(rng)};
+std::string put_down_detail(const Pose2& pose) {
+  char detail[96];
+  std::snprintf(detail, sizeof detail, "put down at (%.2f, %.2f, %.1f deg)", pose.x(), pose.y(),
+                pose.yaw() / kDeg);
+  return detail;
 }
 
 // Points every `step` metres along a polyline, with the heading of the segment they lie on.
@@ -197,184 +182,71 @@ std::vector<Pose2> resample(const std::vector<Vector2d>& pts, double step) {
   return out;
 }
 
-struct Pending {
-  std::int64_t available_ns;
-  std::uint64_t order;
-  io::ImageFrame frame;
-  bool operator>(const Pending& o) const {
-    return available_ns != o.available_ns ? available_ns > o.available_ns : order > o.order;
-  }
-};
-
 }  // namespace
 
 RecordStats record_mission(const Scenario& s, const std::string& path,
                            const std::function<void(double)>& progress) {
   s.validate();
-  RecordStats stats;
-  // Independent random streams, all from the one seed, so that (say) a frame drop does not change
-  // the odometry noise that follows.
-  std::mt19937_64 rng_events(s.seed * 0x9E3779B97F4A7C15ULL + 1);
-  std::mt19937_64 rng_render(s.seed * 0x9E3779B97F4A7C15ULL + 2);
-  std::mt19937_64 rng_bumps(s.seed * 0x9E3779B97F4A7C15ULL + 3);
-  WheelEncoders encoders(s.odometry, s.seed * 0x9E3779B97F4A7C15ULL + 4);
-  const double true_axis = s.robot.semi_axis * (1.0 + s.odometry.semi_axis_error);
-
-  std::optional<CeilingRenderer> ceiling;
-  std::optional<OmniRenderer> omni;
-  if (s.ceiling_rate > 0) ceiling.emplace(*s.robot.find_camera("ceiling_camera"), s.ceiling);
-  if (s.omni_rate > 0) omni.emplace(*s.robot.find_camera("omni_camera"), s.omni);
-
-  io::MissionLogWriter log(path);
-  log.attach_robot(to_robot_json(s.robot));
-  log.attach_map(s.map_geojson);
-  const Stamp t0 = stamp_from_nanoseconds(0);
-  for (const auto& text : s.commands) log.write(t0, io::CommandMessage{t0, text});
-  for (const auto& id : s.failed_lamps) log.write(t0, io::MissionEvent{t0, "lamp_failure", id});
-
-  std::vector<const graph::Lamp*> working;
-  for (const auto& n : s.map.nodes()) {
-    for (const auto& l : n.lamps) {
-      if (!s.failed_lamps.count(l.id.value)) working.push_back(&l);
-    }
-  }
-  auto lamps_near = [&](const Pose2& p, double radius) {
-    std::vector<const graph::Lamp*> out;
-    for (const graph::Lamp* l : s.map.lamps_within(p.translation(), radius)) {
-      if (!s.failed_lamps.count(l->id.value)) out.push_back(l);
-    }
-    return out;
-  };
-  std::normal_distribution<double> bump(0.0, 1.0);
-  auto tilt = [&] {
-    CameraTilt t;
-    if (s.bump_sigma_rad > 0) {
-      t.roll = s.bump_sigma_rad * bump(rng_bumps);
-      t.pitch = s.bump_sigma_rad * bump(rng_bumps);
-    }
-    return t;
-  };
-  std::uniform_real_distribution<double> uni(0.0, 1.0);
-  std::priority_queue<Pending, std::vector<Pending>, std::greater<Pending>> pending;
-  std::uint64_t order = 0;
-  auto flush = [&](std::int64_t until_ns) {
-    while (!pending.empty() && pending.top().available_ns <= until_ns) {
-      log.write_image(stamp_from_nanoseconds(pending.top().available_ns), pending.top().frame);
-      pending.pop();
-    }
-  };
-  auto capture = [&](const Pose2& pose, std::int64_t t_ns, bool is_ceiling) {
-    const Stamp t = stamp_from_nanoseconds(t_ns);
-    if (uni(rng_events) < s.frame_drop_probability) {
-      ++stats.dropped_frames;
-      log.write(t,
-                io::MissionEvent{t, "frame_drop", is_ceiling ? "ceiling_camera" : "omni_camera"});
-      return;
-    }
-    const CameraTilt tl = tilt();
-    const Image8 img = is_ceiling ? ceiling->render(pose, tl, lamps_near(pose, 6.0), rng_render)
-                                  : omni->render(pose, tl, working, rng_render);
-    io::ImageFrame f{t, is_ceiling ? "ceiling_camera" : "omni_camera", "png",
-                     io::encode_png(img, 1)};
-    const double delay = is_ceiling ? s.ceiling_delay_s : s.omni_delay_s;
-    pending.push(
-        {t_ns + static_cast<std::int64_t>(std::llround(delay * 1e9)), order++, std::move(f)});
-    ++(is_ceiling ? stats.ceiling_frames : stats.omni_frames);
-  };
-
-  const std::int64_t dt_ns = std::llround(1e9 / s.odometry_rate);
-  const std::int64_t ceiling_ns = s.ceiling_rate > 0 ? std::llround(1e9 / s.ceiling_rate) : 0;
-  const std::int64_t omni_ns = s.omni_rate > 0 ? std::llround(1e9 / s.omni_rate) : 0;
-  std::int64_t t_ns = 0, next_ceiling = 0, next_omni = 0;
-  Pose2 pose = s.start;
-  auto write_state = [&] {
-    const Stamp t = stamp_from_nanoseconds(t_ns);
-    const WheelTravel& r = encoders.readings();
-    log.write(t, io::WheelReading{t, r.left, r.right});
-    log.write(t, io::TruthPose{t, pose});
-    ++stats.wheel_messages;
-  };
-
+  World world(s, path);
   if (s.carried) {
     // Carried between captures: each capture point is a kidnap from the last; the wheels never
     // turn (their readings stay put, so odometry knows nothing of the jumps).
     const auto stops = resample(s.waypoints, s.jump_m);
+    const std::int64_t omni_ns = s.omni_rate > 0 ? std::llround(1e9 / s.omni_rate) : 0;
     const std::int64_t period = omni_ns > 0 ? 2 * omni_ns : 2'000'000'000;
     std::normal_distribution<double> jitter(0.0, 1.0);
+    std::mt19937_64& rng_jitter = world.event_rng();
     for (std::size_t i = 0; i < stops.size(); ++i) {
-      pose = Pose2(stops[i].x() + 0.3 * jitter(rng_events), stops[i].y() + 0.3 * jitter(rng_events),
-                   stops[i].yaw() + 20 * kDeg * jitter(rng_events));
+      const Pose2 stop(stops[i].x() + 0.3 * jitter(rng_jitter),
+                       stops[i].y() + 0.3 * jitter(rng_jitter),
+                       stops[i].yaw() + 20 * kDeg * jitter(rng_jitter));
       if (i > 0) {
-        log.write(
-            stamp_from_nanoseconds(t_ns),
-            io::MissionEvent{stamp_from_nanoseconds(t_ns), "kidnap", "carried to the next stop"});
-        ++stats.kidnaps;
-        stats.path_length_m += (stops[i].translation() - stops[i - 1].translation()).norm();
+        world.put_down(stop, "carried to the next stop");
+        world.stats().path_length_m += (stops[i].translation() - stops[i - 1].translation()).norm();
+      } else {
+        world.place(stop);
       }
-      for (std::int64_t k = 0; k < period; k += dt_ns) {
-        write_state();
-        if (k == dt_ns) {
-          if (omni) capture(pose, t_ns, false);
-          if (ceiling) capture(pose, t_ns, true);
-        }
-        flush(t_ns);
-        t_ns += dt_ns;
+      for (std::int64_t k = 0; k < period; k += world.period_ns()) {
+        world.hold();
+        if (k == world.period_ns()) world.capture_all();
+        world.deliver(world.now_ns());
+        world.advance();
       }
       if (progress) progress(static_cast<double>(i + 1) / stops.size());
     }
-    stats.arrived = true;
+    world.stats().arrived = true;
   } else {
     navigation::PathFollower follower(s.waypoints, {s.max_speed, 0.8, 0.6, 0.1});
     const double expected = path_length(s.waypoints) / s.max_speed;
     std::size_t kidnap_index = 0;
-    while (!follower.arrived() && t_ns < static_cast<std::int64_t>(s.max_duration_s * 1e9)) {
-      const double t_s = t_ns * 1e-9;
+    while (!follower.arrived() &&
+           world.now_ns() < static_cast<std::int64_t>(s.max_duration_s * 1e9)) {
+      const double t_s = world.now_ns() * 1e-9;
       if (kidnap_index < s.kidnaps.size() && t_s >= s.kidnaps[kidnap_index].at_s) {
         const Kidnap& k = s.kidnaps[kidnap_index++];
-        pose = k.to ? *k.to : random_place(s.map, rng_events);
-        const Stamp t = stamp_from_nanoseconds(t_ns);
-        char detail[96];
-        std::snprintf(detail, sizeof detail, "put down at (%.2f, %.2f, %.1f deg)", pose.x(),
-                      pose.y(), pose.yaw() / kDeg);
-        log.write(t, io::MissionEvent{t, "kidnap", detail});
-        ++stats.kidnaps;
+        const Pose2 to = k.to ? *k.to : world.random_place();
+        world.put_down(to, put_down_detail(to));
         // The person at the joystick drives on to the goal from where the robot now stands.
-        std::vector<Vector2d> pts{pose.translation()};
+        std::vector<Vector2d> pts{to.translation()};
         if (!s.goal.empty()) {
-          if (const auto route = graph::plan_route(s.map, pose, s.map.find_node(s.goal)->id)) {
+          if (const auto route = graph::plan_route(s.map, to, s.map.find_node(s.goal)->id)) {
             for (const auto& p : graph::route_waypoints(s.map, *route)) pts.push_back(p);
           }
         }
         if (pts.size() < 2) pts.push_back(s.waypoints.back());
         follower = navigation::PathFollower(pts, {s.max_speed, 0.8, 0.6, 0.1});
       }
-      const auto [v, w] = follower.command(pose);
-      const WheelTravel travel = wheel_travel(v * dt_ns * 1e-9, w * dt_ns * 1e-9, true_axis);
-      pose = drive(pose, travel, true_axis);
-      stats.path_length_m += std::fabs(0.5 * (travel.left + travel.right));
-      encoders.step(travel);
-      t_ns += dt_ns;
-      write_state();
-      if (ceiling && t_ns >= next_ceiling) {
-        capture(pose, t_ns, true);
-        next_ceiling += ceiling_ns;
-      }
-      if (omni && t_ns >= next_omni) {
-        capture(pose, t_ns, false);
-        next_omni += omni_ns;
-      }
-      flush(t_ns);
-      if (progress && (t_ns / dt_ns) % 50 == 0)
+      const auto [v, w] = follower.command(world.pose());
+      world.drive(v, w);
+      world.deliver(world.now_ns());
+      if (progress && (world.now_ns() / world.period_ns()) % 50 == 0)
         progress(std::min(0.99, t_s / std::max(1.0, expected)));
     }
-    stats.arrived = follower.arrived();
+    world.stats().arrived = follower.arrived();
   }
-  flush(INT64_MAX);
-  log.close();
-  stats.duration_s = t_ns * 1e-9;
-  stats.slips = encoders.slips();
+  world.finish();
   if (progress) progress(1.0);
-  return stats;
+  return world.stats();
 }
 
 }  // namespace lampnav::sim

@@ -1,0 +1,40 @@
+#pragma once
+// The small interface the stack drives a robot through: wheel speeds out; wheel readings and
+// camera frames in, in the order they arrive. A real robot, the simulated one (sim/) and a
+// recorded mission (replay) all stand behind it.
+
+#include <optional>
+#include <variant>
+
+#include "lampnav/core/image.hpp"
+#include "lampnav/core/time.hpp"
+
+namespace lampnav::navigation {
+
+enum class CameraRole { ceiling, omni };
+
+struct WheelInput {
+  Stamp stamp;                  // read at
+  double left = 0, right = 0;  // cumulative travel of each wheel, m
+};
+
+struct FrameInput {
+  CameraRole camera = CameraRole::ceiling;
+  Stamp capture;  // when the picture was taken
+  Stamp arrival;  // when it reached the stack (capture + transfer + processing)
+  Image8 image;
+};
+
+using RobotInput = std::variant<WheelInput, FrameInput>;
+
+class Robot {
+ public:
+  virtual ~Robot() = default;
+  // Wheel speeds (m/s) to hold until the next call. A recorded robot ignores them.
+  virtual void set_wheel_speeds(double left, double right) = 0;
+  // The next input in arrival order; nullopt when there will be no more. A real robot waits for
+  // it; a simulated or recorded one produces it at once.
+  virtual std::optional<RobotInput> next() = 0;
+};
+
+}  // namespace lampnav::navigation
