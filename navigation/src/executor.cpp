@@ -44,7 +44,8 @@ double distance_to_path(const std::vector<Eigen::Vector2d>& pts, const Eigen::Ve
   double best = pts.empty() ? 0.0 : (pts.front() - p).norm();
   for (std::size_t k = 1; k < pts.size(); ++k) {
     const Eigen::Vector2d a = pts[k - 1], b = pts[k];
-    const double t = std::clamp((p - a).dot(b - a) / std::max(1e-12, (b - a).squaredNorm()), 0.0, 1.0);
+    const double t =
+        std::clamp((p - a).dot(b - a) / std::max(1e-12, (b - a).squaredNorm()), 0.0, 1.0);
     best = std::min(best, (a + t * (b - a) - p).norm());
   }
   return best;
@@ -62,7 +63,8 @@ Executor::Executor(const graph::TopologicalMap& map, double semi_axis,
                    const ExecutorOptions& options)
     : map_(&map), semi_axis_(semi_axis), o_(options) {
   o_.validate();
-  if (!(semi_axis > 0)) throw InputError({"", "robot.json", "wheels.semi_axis"}, "must be positive");
+  if (!(semi_axis > 0))
+    throw InputError({"", "robot.json", "wheels.semi_axis"}, "must be positive");
 }
 
 bool Executor::adopt(Stamp stamp, const Pose2& pose,
@@ -75,7 +77,7 @@ bool Executor::adopt(Stamp stamp, const Pose2& pose,
   plan_ = std::move(*i.plan);
   goal_ = map_->node(plan_.route.nodes.back()).name;
   follower_.emplace(plan_.waypoints, PathFollower::Options{o_.max_speed, o_.max_turn_rate,
-                                                            o_.lookahead, o_.goal_tolerance});
+                                                           o_.lookahead, o_.goal_tolerance});
   reached_ = 0;
   last_node_ = &map_->node(plan_.route.nodes.front());
   status_ = ExecutorStatus::driving;

@@ -14,7 +14,7 @@ namespace lampnav::navigation {
 enum class CameraRole { ceiling, omni };
 
 struct WheelInput {
-  Stamp stamp;                  // read at
+  Stamp stamp;                 // read at
   double left = 0, right = 0;  // cumulative travel of each wheel, m
 };
 

@@ -1,0 +1,92 @@
+#include "lampnav/navigation/runtime.hpp"
+
+#include <cmath>
+
+#include "lampnav/core/error.hpp"
+
+namespace lampnav::navigation {
+
+void RuntimeOptions::validate() const {
+  localizer.validate();
+  executor.validate();
+  if (!(max_duration_s > 0))
+    throw InputError({"", "runtime options", "max_duration_s"}, "must be positive");
+  if (!(start_sigma_m > 0) || !(start_sigma_deg > 0))
+    throw InputError({"", "runtime options", "start_sigma"}, "must be positive");
+}
+
+Runtime::Runtime(const graph::TopologicalMap& map, const RobotDescription& robot,
+                 const RuntimeOptions& options)
+    : map_(&map),
+      o_(options),
+      localizer_(map, robot, options.localizer),
+      executor_(map, robot.semi_axis, options.executor) {
+  o_.validate();
+}
+
+RunOutcome Runtime::run(Robot& robot, const std::optional<Pose2>& start,
+                        const std::vector<graph::RouteCommand>& commands,
+                        RuntimeObserver* observer) {
+  RunOutcome out;
+  RuntimeObserver none;
+  RuntimeObserver& obs = observer ? *observer : none;
+  const bool driving = !commands.empty();
+  auto stop = [&] { robot.set_wheel_speeds(0, 0); };
+  while (auto input = robot.next()) {
+    if (const auto* w = std::get_if<WheelInput>(&*input)) {
+      if (!out.first) {
+        out.first = w->stamp;
+        if (start) {
+          const double sp = o_.start_sigma_m, sy = o_.start_sigma_deg * M_PI / 180;
+          localizer_.initialize(w->stamp, *start,
+                                Eigen::Vector3d(sp * sp, sp * sp, sy * sy).asDiagonal());
+        }
+      }
+      out.last = w->stamp;
+      ++out.wheel_readings;
+      localizer_.wheels(w->stamp, w->left, w->right);
+      if (!localizer_.initialized()) continue;
+      const fusion::LocalizerEstimate e = localizer_.estimate();
+      obs.on_estimate(e);
+      if (driving) {
+        if (executor_.status() == ExecutorStatus::idle && e.mode != fusion::LocalizerMode::lost)
+          executor_.start(e.stamp, e.pose, commands);
+        const WheelSpeeds s = executor_.step(e);
+        robot.set_wheel_speeds(s.left, s.right);
+        if (executor_.status() == ExecutorStatus::arrived) break;
+        if (executor_.status() == ExecutorStatus::failed) {
+          out.reason = executor_.reason();
+          break;
+        }
+      }
+      if (to_seconds(*out.last - *out.first) > o_.max_duration_s) {
+        out.time_limit = true;
+        break;
+      }
+      continue;
+    }
+    const auto& f = std::get<FrameInput>(*input);
+    const vision::ImageView view = vision::ImageView::of(f.image);
+    try {
+      if (f.camera == CameraRole::ceiling) {
+        if (!localizer_.has_ceiling_camera()) continue;
+        ++out.ceiling_frames;
+        obs.on_ceiling(f, localizer_.ceiling_frame(f.capture, view));
+      } else {
+        if (!localizer_.has_omni_camera()) continue;
+        ++out.omni_frames;
+        obs.on_omni(f, localizer_.omni_frame(f.capture, view));
+      }
+    } catch (const InputError& e) {
+      ++out.refused_frames;
+      obs.on_refused(f, e.what());
+    }
+  }
+  stop();
+  out.status = executor_.status();
+  if (driving && out.status != ExecutorStatus::arrived && out.reason.empty())
+    out.reason = out.time_limit ? "the time limit came first" : "the robot stopped giving input";
+  return out;
+}
+
+}  // namespace lampnav::navigation
