@@ -1,5 +1,6 @@
 #include "lampnav/io/mission_log.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <map>
@@ -155,6 +156,17 @@ std::vector<ChannelSpec> channel_specs() {
            R"(, "kind": {"type": "string"}, "detail": {"type": "string"}}})"},
       {topics::kCommands, "lampnav.Command",
        R"({"type": "object", "properties": {)" + t + R"(, "text": {"type": "string"}}})"},
+      {topics::kPose, "foxglove.PoseInFrame",
+       R"({"type": "object", "properties": {)" + t +
+           R"(, "frame_id": {"type": "string"}, "pose": {"type": "object", "properties": {"position": {"type": "object"}, "orientation": {"type": "object"}}}}})"},
+      {topics::kEstimate, "lampnav.PoseEstimate",
+       R"({"type": "object", "properties": {)" + t +
+           R"(, "x": {"type": "number"}, "y": {"type": "number"}, "yaw": {"type": "number"}, "covariance": {"type": "array", "items": {"type": "number"}, "minItems": 9, "maxItems": 9}, "node": {"type": ["string", "null"]}, "mode": {"type": "string", "enum": ["tracking", "lost", "relocalized"]}}})"},
+      {topics::kLamps, "lampnav.LampObservations",
+       R"({"type": "object", "properties": {)" + t +
+           R"(, "camera": {"type": "string"}, "lamps": {"type": "array", "items": {"type": "object", "properties": {"u": {"type": "number"}, "v": {"type": "number"}, "orientation": {"type": "number"}, "area": {"type": "number"}, "track": {"type": "integer"}, "label": {"type": ["string", "null"]}}}}}})"},
+      {topics::kScene, "foxglove.SceneUpdate",
+       R"({"type": "object", "properties": {"deletions": {"type": "array"}, "entities": {"type": "array"}}})"},
   };
 }
 
@@ -189,6 +201,22 @@ struct MissionLogWriter::Impl {
   }
 };
 
+namespace {
+
+Json pose_json(const Pose2& p) {
+  const double h = p.yaw() / 2;
+  return {{"position", {{"x", p.x()}, {"y", p.y()}, {"z", 0.0}}},
+          {"orientation", {{"x", 0.0}, {"y", 0.0}, {"z", std::sin(h)}, {"w", std::cos(h)}}}};
+}
+
+Json color_json(const SceneColor& c) { return {{"r", c.r}, {"g", c.g}, {"b", c.b}, {"a", c.a}}; }
+
+Json point_json(const Eigen::Vector3d& p) { return {{"x", p.x()}, {"y", p.y()}, {"z", p.z()}}; }
+
+Json identity_pose_json() { return pose_json(Pose2()); }
+
+}  // namespace
+
 MissionLogWriter::MissionLogWriter(const std::string& path, McapWriterOptions options)
     : impl_(std::make_unique<Impl>(path, std::move(options))) {}
 MissionLogWriter::~MissionLogWriter() = default;
@@ -212,15 +240,93 @@ void MissionLogWriter::write_image(Stamp available, const ImageFrame& f) {
                   {"format", f.format},
                   {"data", base64_encode(f.data)}});
 }
+void MissionLogWriter::write(Stamp available, const PoseEstimate& e) {
+  impl_->put(
+      topics::kPose, available, e.stamp,
+      Json{{"timestamp", stamp_json(e.stamp)}, {"frame_id", "map"}, {"pose", pose_json(e.pose)}});
+  Json cov = Json::array();
+  for (double c : e.covariance) cov.push_back(c);
+  impl_->put(topics::kEstimate, available, e.stamp,
+             Json{{"timestamp", stamp_json(e.stamp)},
+                  {"x", e.pose.x()},
+                  {"y", e.pose.y()},
+                  {"yaw", e.pose.yaw()},
+                  {"covariance", cov},
+                  {"node", e.node.empty() ? Json(nullptr) : Json(e.node)},
+                  {"mode", e.mode}});
+}
+
+void MissionLogWriter::write(Stamp available, const LampObservations& o) {
+  Json lamps = Json::array();
+  for (const auto& l : o.lamps)
+    lamps.push_back({{"u", l.u},
+                     {"v", l.v},
+                     {"orientation", l.orientation},
+                     {"area", l.area},
+                     {"track", l.track},
+                     {"label", l.label ? Json(*l.label) : Json(nullptr)}});
+  impl_->put(topics::kLamps, available, o.stamp,
+             Json{{"timestamp", stamp_json(o.stamp)}, {"camera", o.camera}, {"lamps", lamps}});
+}
+
+void MissionLogWriter::write(Stamp available, const SceneUpdate& u) {
+  Json entities = Json::array();
+  for (const auto& e : u.entities) {
+    Json lines = Json::array(), cubes = Json::array(), texts = Json::array();
+    for (const auto& l : e.lines) {
+      Json pts = Json::array();
+      for (const auto& p : l.points) pts.push_back(point_json(p));
+      lines.push_back({{"type", 0},  // LINE_STRIP
+                       {"pose", identity_pose_json()},
+                       {"thickness", l.thickness},
+                       {"scale_invariant", false},
+                       {"points", pts},
+                       {"color", color_json(l.color)},
+                       {"colors", Json::array()},
+                       {"indices", Json::array()}});
+    }
+    for (const auto& c : e.cubes) {
+      const double h = c.yaw / 2;
+      cubes.push_back(
+          {{"pose",
+            {{"position", point_json(c.centre)},
+             {"orientation", {{"x", 0.0}, {"y", 0.0}, {"z", std::sin(h)}, {"w", std::cos(h)}}}}},
+           {"size", point_json(c.size)},
+           {"color", color_json(c.color)}});
+    }
+    for (const auto& t : e.texts) {
+      texts.push_back({{"pose",
+                        {{"position", point_json(t.at)},
+                         {"orientation", {{"x", 0.0}, {"y", 0.0}, {"z", 0.0}, {"w", 1.0}}}}},
+                       {"billboard", true},
+                       {"font_size", t.size},
+                       {"scale_invariant", false},
+                       {"color", color_json(t.color)},
+                       {"text", t.text}});
+    }
+    entities.push_back({{"timestamp", stamp_json(u.stamp)},
+                        {"frame_id", "map"},
+                        {"id", e.id},
+                        {"lifetime", {{"sec", 0}, {"nsec", 0}}},
+                        {"frame_locked", false},
+                        {"metadata", Json::array()},
+                        {"arrows", Json::array()},
+                        {"cubes", cubes},
+                        {"spheres", Json::array()},
+                        {"cylinders", Json::array()},
+                        {"lines", lines},
+                        {"triangles", Json::array()},
+                        {"texts", texts},
+                        {"models", Json::array()}});
+  }
+  impl_->put(topics::kScene, available, u.stamp,
+             Json{{"deletions", Json::array()}, {"entities", entities}});
+}
+
 void MissionLogWriter::write(Stamp available, const TruthPose& t) {
-  const double h = t.pose.yaw() / 2;
   impl_->put(
       topics::kTruth, available, t.stamp,
-      Json{{"timestamp", stamp_json(t.stamp)},
-           {"frame_id", "map"},
-           {"pose",
-            {{"position", {{"x", t.pose.x()}, {"y", t.pose.y()}, {"z", 0.0}}},
-             {"orientation", {{"x", 0.0}, {"y", 0.0}, {"z", std::sin(h)}, {"w", std::cos(h)}}}}}});
+      Json{{"timestamp", stamp_json(t.stamp)}, {"frame_id", "map"}, {"pose", pose_json(t.pose)}});
 }
 void MissionLogWriter::write(Stamp available, const MissionEvent& e) {
   impl_->put(topics::kEvents, available, e.stamp,
@@ -328,6 +434,26 @@ MissionLog read_mission_log(const std::string& path) {
     }
   }
   return log;
+}
+
+TruthTrack::TruthTrack(std::vector<Logged<TruthPose>> truth) : truth_(std::move(truth)) {
+  std::stable_sort(truth_.begin(), truth_.end(),
+                   [](const auto& a, const auto& b) { return a.value.stamp < b.value.stamp; });
+}
+
+Pose2 TruthTrack::at(Stamp t) const {
+  if (truth_.empty()) return {};
+  auto it = std::lower_bound(truth_.begin(), truth_.end(), t,
+                             [](const auto& a, Stamp s) { return a.value.stamp < s; });
+  if (it == truth_.begin()) return it->value.pose;
+  if (it == truth_.end()) return truth_.back().value.pose;
+  const auto& b = it->value;
+  if (b.stamp == t) return b.pose;
+  const auto& a = std::prev(it)->value;
+  if ((b.pose.translation() - a.pose.translation()).norm() > 0.5) return a.pose;
+  const double f = to_seconds(t - a.stamp) / std::max(1e-12, to_seconds(b.stamp - a.stamp));
+  return Pose2(a.pose.translation() + f * (b.pose.translation() - a.pose.translation()),
+               wrap_angle(a.pose.yaw() + f * wrap_angle(b.pose.yaw() - a.pose.yaw())));
 }
 
 }  // namespace lampnav::io

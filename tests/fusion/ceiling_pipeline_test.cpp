@@ -14,7 +14,6 @@
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/sim/scenario.hpp"
 #include "lampnav_test.hpp"
-#include "mission_truth.hpp"
 
 namespace lampnav::fusion {
 namespace {
@@ -28,8 +27,6 @@ struct Score {
   double mean_pos() const { return sum_pos / measurements; }
   double mean_yaw_deg() const { return sum_yaw / measurements * 180 / M_PI; }
 };
-
-using test::truth_at;
 
 Score corridor(double bump_rad, const std::set<std::string>& failed, std::uint64_t seed) {
   const std::string geojson = test::slurp(test::source_path("maps/office_floor.geojson"));
@@ -49,7 +46,7 @@ Score corridor(double bump_rad, const std::set<std::string>& failed, std::uint64
   auto by_capture = [](const auto& a, const auto& b) { return a.value.stamp < b.value.stamp; };
   std::sort(log.ceiling_images.begin(), log.ceiling_images.end(), by_capture);
   std::sort(log.wheels.begin(), log.wheels.end(), by_capture);
-  std::sort(log.truth.begin(), log.truth.end(), by_capture);
+  const io::TruthTrack truth_track(log.truth);
 
   const CameraDescription& cam = *robot.find_camera("ceiling_camera");
   CeilingPipeline pipeline(map, cam);
@@ -80,7 +77,7 @@ Score corridor(double bump_rad, const std::set<std::string>& failed, std::uint64
     const Image8 img = io::decode_image(f.value.data, "frame");
     const CeilingObservation ob = pipeline.process(t, vision::ImageView::of(img), pose, P);
     ++sc.frames;
-    const Pose2 truth = truth_at(log.truth, t);
+    const Pose2 truth = truth_track.at(t);
     for (const auto& l : ob.lamps) {
       if (l.detection.view == vision::LampView::partial) continue;
       ++sc.lamps_seen;

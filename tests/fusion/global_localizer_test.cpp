@@ -15,7 +15,6 @@
 #include "lampnav/sim/scenario.hpp"
 #include "lampnav/vision/camera_models.hpp"
 #include "lampnav_test.hpp"
-#include "mission_truth.hpp"
 
 namespace lampnav::fusion {
 namespace {
@@ -80,15 +79,13 @@ DomusRun record_domus(const std::string& scenario, double bump_deg, std::uint64_
   sim::record_mission(s, path);
   const io::MissionLog log = io::read_mission_log(path);
   std::filesystem::remove(path);
-  std::vector<io::Logged<io::TruthPose>> truth = log.truth;
-  std::sort(truth.begin(), truth.end(),
-            [](const auto& a, const auto& b) { return a.value.stamp < b.value.stamp; });
+  const io::TruthTrack truth(log.truth);
   vision::OmniLampDetector detector(m.cam());
   DomusRun run;
   for (const auto& f : log.omni_images) {
     const Image8 img = io::decode_image(f.value.data, "omni frame");
     run.detections.push_back(detector.detect(vision::ImageView::of(img)));
-    run.truth.push_back(test::truth_at(truth, f.value.stamp));
+    run.truth.push_back(truth.at(f.value.stamp));
   }
   return run;
 }

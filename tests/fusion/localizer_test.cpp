@@ -14,15 +14,12 @@
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/sim/scenario.hpp"
 #include "lampnav_test.hpp"
-#include "mission_truth.hpp"
 
 namespace lampnav::fusion {
 namespace {
 
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
-
-using test::truth_at;
 
 struct Kidnapped {
   Stamp at;                    // lifted (log event)
@@ -91,9 +88,7 @@ io::MissionLog record(const sim::Scenario& s) {
 Outcome replay(const sim::Scenario& s, const io::MissionLog& log, const graph::TopologicalMap& map,
                bool start_known = true) {
   Localizer loc(map, s.robot);
-  std::vector<io::Logged<io::TruthPose>> truth = log.truth;
-  auto by_stamp = [](const auto& a, const auto& b) { return a.value.stamp < b.value.stamp; };
-  std::sort(truth.begin(), truth.end(), by_stamp);
+  const io::TruthTrack truth(log.truth);
   enum Kind { wheels, ceiling, omni };
   struct Item {
     Stamp arrival;
@@ -117,7 +112,7 @@ Outcome replay(const sim::Scenario& s, const io::MissionLog& log, const graph::T
   bool unsure = false;
   std::size_t next_kidnap = 0, events_seen = start_known ? 1 : 0;  // after "initialized"
   if (start_known)
-    loc.initialize(log.wheels.front().value.stamp, truth_at(truth, log.wheels.front().value.stamp),
+    loc.initialize(log.wheels.front().value.stamp, truth.at(log.wheels.front().value.stamp),
                    Vector3d(1e-4, 1e-4, 3e-4).asDiagonal());
   else
     unsure = true;
@@ -133,7 +128,7 @@ Outcome replay(const sim::Scenario& s, const io::MissionLog& log, const graph::T
       ++run.wheel_steps;
       const LocalizerEstimate e = loc.estimate();
       if (!unsure && e.mode == LocalizerMode::tracking) {
-        const Pose2 t = truth_at(truth, e.stamp);
+        const Pose2 t = truth.at(e.stamp);
         const double ep = (e.pose.translation() - t.translation()).norm();
         const double ey = std::fabs(wrap_angle(e.pose.yaw() - t.yaw()));
         ++run.scored;
@@ -167,7 +162,7 @@ Outcome replay(const sim::Scenario& s, const io::MissionLog& log, const graph::T
       if (ev.mode == LocalizerMode::relocalized) {
         // The omni relocalizer's fix, scored against the truth when it is made.
         const LocalizerEstimate e = loc.estimate();
-        const Pose2 t = truth_at(truth, e.stamp);
+        const Pose2 t = truth.at(e.stamp);
         const double ep = (e.pose.translation() - t.translation()).norm();
         run.max_fix_error = std::max(run.max_fix_error, ep);
         ++run.relocalizations;

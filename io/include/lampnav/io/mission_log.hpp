@@ -3,6 +3,8 @@
 // robot.json and map.geojson attached. Each message's `timestamp` is when its data was CAPTURED;
 // the MCAP log_time is when it became AVAILABLE to the stack.
 
+#include <Eigen/Core>
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -22,6 +24,11 @@ inline constexpr const char* kOmniImage = "/omni_camera/image";
 inline constexpr const char* kTruth = "/truth/pose";
 inline constexpr const char* kEvents = "/events";
 inline constexpr const char* kCommands = "/commands";
+// What a replay adds.
+inline constexpr const char* kPose = "/lampnav/pose";
+inline constexpr const char* kEstimate = "/lampnav/estimate";
+inline constexpr const char* kLamps = "/lampnav/lamps";
+inline constexpr const char* kScene = "/lampnav/scene";
 }  // namespace topics
 
 struct WheelReading {
@@ -52,6 +59,61 @@ struct CommandMessage {
   std::string text;
 };
 
+// The fused estimate (/lampnav/pose and /lampnav/estimate).
+struct PoseEstimate {
+  Stamp stamp;
+  Pose2 pose;
+  std::array<double, 9> covariance{};  // row-major, x y yaw
+  std::string node;                    // "" when in no region
+  std::string mode;                    // "tracking", "lost", "relocalized"
+};
+
+// One frame's lamp detections (/lampnav/lamps): pixel centroid, orientation, area, track, label.
+struct LampObservation {
+  double u = 0, v = 0;     // px
+  double orientation = 0;  // rad
+  double area = 0;         // normalized units^2
+  int track = 0;
+  std::optional<std::string> label;  // the map lamp's id
+};
+struct LampObservations {
+  Stamp stamp;
+  std::string camera;
+  std::vector<LampObservation> lamps;
+};
+
+// A drawing for viewers (foxglove.SceneUpdate): line strips, cubes and labels in the map frame.
+struct SceneColor {
+  double r = 0, g = 0, b = 0, a = 1;
+};
+struct SceneLine {
+  std::vector<Eigen::Vector3d> points;
+  SceneColor color;
+  double thickness = 0.05;  // m
+};
+struct SceneCube {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  Eigen::Vector3d size = Eigen::Vector3d::Ones();
+  double yaw = 0;
+  SceneColor color;
+};
+struct SceneText {
+  Eigen::Vector3d at = Eigen::Vector3d::Zero();
+  std::string text;
+  SceneColor color;
+  double size = 0.4;  // m
+};
+struct SceneEntity {
+  std::string id;
+  std::vector<SceneLine> lines;
+  std::vector<SceneCube> cubes;
+  std::vector<SceneText> texts;
+};
+struct SceneUpdate {
+  Stamp stamp;
+  std::vector<SceneEntity> entities;
+};
+
 // A record of a log with the time it became available.
 template <class T>
 struct Logged {
@@ -70,6 +132,10 @@ class MissionLogWriter {
   void write(Stamp available, const TruthPose& t);
   void write(Stamp available, const MissionEvent& e);
   void write(Stamp available, const CommandMessage& c);
+  // Replay outputs: the estimate goes to both /lampnav/pose and /lampnav/estimate.
+  void write(Stamp available, const PoseEstimate& e);
+  void write(Stamp available, const LampObservations& o);
+  void write(Stamp available, const SceneUpdate& u);
   void close();
 
  private:
@@ -92,6 +158,19 @@ struct MissionLog {
 // Reads a mission log. Throws InputError for a file that is not MCAP at all; damaged content is
 // skipped, counted and reported in the result.
 MissionLog read_mission_log(const std::string& path);
+
+// The truth of a log at any instant, interpolated between the samples around it. A kidnap is a
+// jump between two samples (more than 0.5 m): no interpolation across it.
+class TruthTrack {
+ public:
+  explicit TruthTrack(std::vector<Logged<TruthPose>> truth);
+  bool empty() const { return truth_.empty(); }
+  Pose2 at(Stamp t) const;
+  const std::vector<Logged<TruthPose>>& samples() const { return truth_; }  // by stamp
+
+ private:
+  std::vector<Logged<TruthPose>> truth_;
+};
 
 // Base64 (RFC 4648, with padding). decode throws std::invalid_argument naming the bad character.
 std::string base64_encode(const std::string& bytes);
