@@ -1,0 +1,366 @@
+#include "lampnav/navigation/replay.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "lampnav/core/error.hpp"
+#include "lampnav/fusion/ekf.hpp"
+
+namespace lampnav::navigation {
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// The recorded robot.
+
+LogRobot::LogRobot(const io::MissionLog& log, bool use_ceiling, bool use_omni) : log_(&log) {
+  for (std::size_t i = 0; i < log.wheels.size(); ++i)
+    items_.push_back({log.wheels[i].log_time, 0, i});
+  if (use_ceiling)
+    for (std::size_t i = 0; i < log.ceiling_images.size(); ++i)
+      items_.push_back({log.ceiling_images[i].log_time, 1, i});
+  if (use_omni)
+    for (std::size_t i = 0; i < log.omni_images.size(); ++i)
+      items_.push_back({log.omni_images[i].log_time, 2, i});
+  // Arrival order; at the same instant the wheel reading first, as the robot delivered them.
+  std::stable_sort(items_.begin(), items_.end(), [](const Item& a, const Item& b) {
+    return a.arrival != b.arrival ? a.arrival < b.arrival : a.kind == 0 && b.kind != 0;
+  });
+}
+
+std::optional<RobotInput> LogRobot::next() {
+  while (next_ < items_.size()) {
+    const Item& it = items_[next_++];
+    if (it.kind == 0) {
+      const auto& w = log_->wheels[it.index];
+      return WheelInput{w.value.stamp, w.value.left, w.value.right};
+    }
+    const auto& f = (it.kind == 1 ? log_->ceiling_images : log_->omni_images)[it.index];
+    try {
+      return FrameInput{it.kind == 1 ? CameraRole::ceiling : CameraRole::omni, f.value.stamp,
+                        f.log_time, io::decode_image(f.value.data, f.value.frame_id)};
+    } catch (const InputError& e) {
+      problems_.push_back(std::string(it.kind == 1 ? "ceiling" : "omni") + " frame captured at " +
+                          std::to_string(to_seconds(f.value.stamp)) + " s: " + e.message());
+    }
+  }
+  return std::nullopt;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Replay.
+
+namespace {
+
+// Collects what the loop saw.
+struct Recorder : RuntimeObserver {
+  ReplayResult* r;
+  void on_estimate(const fusion::LocalizerEstimate& e) override {
+    r->estimates.push_back({e.stamp, e.pose, e.covariance, e.mode, e.node ? e.node->name : ""});
+  }
+  void on_ceiling(const FrameInput& f, const fusion::CeilingObservation& ob) override {
+    LampFrame lf;
+    lf.arrival = f.arrival;
+    lf.observations.stamp = f.capture;
+    lf.observations.camera = "ceiling_camera";
+    for (const auto& l : ob.lamps) {
+      io::LampObservation o;
+      o.u = l.detection.centre_px.x();
+      o.v = l.detection.centre_px.y();
+      o.orientation = l.detection.orientation;
+      o.area = l.detection.area;
+      o.track = l.track_id;
+      if (l.lamp) o.label = l.lamp->id.value;
+      lf.observations.lamps.push_back(o);
+    }
+    r->lamp_frames.push_back(std::move(lf));
+  }
+};
+
+ErrorStats stats_of(const std::vector<double>& v) {
+  ErrorStats s;
+  s.n = v.size();
+  if (v.empty()) return s;
+  double sum = 0, sum2 = 0;
+  for (double x : v) {
+    sum += x;
+    sum2 += x * x;
+    s.max = std::max(s.max, x);
+  }
+  s.mean = sum / v.size();
+  s.rms = std::sqrt(sum2 / v.size());
+  return s;
+}
+
+void score(ReplayResult& r, const io::MissionLog& log) {
+  Metrics& m = r.metrics;
+  m.ceiling_frames = r.outcome.ceiling_frames;
+  m.omni_frames = r.outcome.omni_frames;
+  m.frames = m.ceiling_frames + m.omni_frames;
+  m.duration_s = r.outcome.duration_s();
+  for (const auto& f : r.lamp_frames)
+    for (const auto& l : f.observations.lamps) {
+      ++m.lamps_seen;
+      if (l.label) ++m.lamps_labelled;
+    }
+  // Time lost.
+  for (std::size_t k = 1; k < r.estimates.size(); ++k)
+    if (r.estimates[k - 1].mode == fusion::LocalizerMode::lost)
+      m.lost_s += to_seconds(r.estimates[k].stamp - r.estimates[k - 1].stamp);
+  // Kidnaps and the fixes after them.
+  std::vector<Stamp> kidnaps, fixes;
+  for (const auto& e : log.events)
+    if (e.value.kind == "kidnap") kidnaps.push_back(e.value.stamp);
+  std::sort(kidnaps.begin(), kidnaps.end());
+  for (const auto& e : r.events)
+    if (e.mode == fusion::LocalizerMode::relocalized) fixes.push_back(e.stamp);
+  m.kidnaps = static_cast<int>(kidnaps.size());
+  std::vector<double> latency;
+  std::vector<std::pair<Stamp, std::optional<Stamp>>> unsure;  // kidnap to its fix
+  for (std::size_t k = 0; k < kidnaps.size(); ++k) {
+    const Stamp until = k + 1 < kidnaps.size() ? kidnaps[k + 1] : Stamp::max();
+    auto fix = std::find_if(fixes.begin(), fixes.end(),
+                            [&](Stamp s) { return s >= kidnaps[k] && s < until; });
+    if (fix != fixes.end()) {
+      ++m.recoveries;
+      latency.push_back(to_seconds(*fix - kidnaps[k]));
+      unsure.push_back({kidnaps[k], *fix});
+    } else {
+      unsure.push_back({kidnaps[k], std::nullopt});
+    }
+  }
+  m.relocalization_latency_s = stats_of(latency);
+  // Errors: tracking estimates outside [kidnap, its fix).
+  m.has_truth = !log.truth.empty();
+  if (!m.has_truth) return;
+  const io::TruthTrack truth(log.truth);
+  std::vector<double> pos, yaw;
+  for (const auto& e : r.estimates) {
+    if (e.mode != fusion::LocalizerMode::tracking) continue;
+    bool skip = false;
+    for (const auto& [from, to] : unsure)
+      if (e.stamp >= from && (!to || e.stamp < *to)) skip = true;
+    if (skip) continue;
+    const Pose2 t = truth.at(e.stamp);
+    pos.push_back((e.pose.translation() - t.translation()).norm());
+    yaw.push_back(std::fabs(wrap_angle(e.pose.yaw() - t.yaw())) / kDeg);
+  }
+  m.position_error_m = stats_of(pos);
+  m.yaw_error_deg = stats_of(yaw);
+}
+
+}  // namespace
+
+ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
+                    const RobotDescription& robot, const ReplayOptions& options) {
+  if (log.wheels.empty())
+    throw JobFailed("the log has no wheel readings (/wheels): nothing to replay");
+  const bool omni =
+      options.use_omni && !log.omni_images.empty() && robot.find_camera("omni_camera");
+  const bool ceiling =
+      options.use_ceiling && !log.ceiling_images.empty() && robot.find_camera("ceiling_camera");
+  if (!options.initial_pose && !omni)
+    throw JobFailed(
+        "no starting pose and no omnidirectional frames to find the robot with: give "
+        "--initial-pose X,Y,YAW");
+  ReplayResult r;
+  r.notes.push_back("inputs: " + std::to_string(log.wheels.size()) + " wheel readings" +
+                    (ceiling ? ", " + std::to_string(log.ceiling_images.size()) + " ceiling frames"
+                             : std::string(", no ceiling camera")) +
+                    (omni ? ", " + std::to_string(log.omni_images.size()) + " omni frames"
+                          : std::string(", no omni camera")));
+  r.notes.push_back(options.initial_pose
+                        ? "started from the given pose"
+                        : "not told where the robot starts: localized globally from the omni "
+                          "camera first");
+  if (log.truth.empty()) r.notes.push_back("the log has no truth (/truth/pose): errors not scored");
+  if (log.report.truncated)
+    r.notes.push_back("the log is truncated (" + log.report.truncation +
+                      "): replayed what it holds");
+  if (log.skipped_messages > 0)
+    r.notes.push_back(std::to_string(log.skipped_messages) + " damaged messages skipped");
+
+  LogRobot robot_in(log, ceiling, omni);
+  Runtime rt(map, robot, options.runtime);
+  Recorder rec;
+  rec.r = &r;
+  const auto t0 = std::chrono::steady_clock::now();
+  r.outcome = rt.run(robot_in, options.initial_pose, {}, &rec);
+  r.metrics.runtime_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  for (const auto& p : robot_in.problems()) r.notes.push_back("skipped " + p);
+  const auto& ev = rt.localizer().events();
+  for (const auto& e : ev)
+    if (e.reason != "initialized") r.events.push_back(e);
+  // Wheels alone, from the first pose the stack had.
+  if (!r.estimates.empty()) {
+    const Stamp from = r.estimates.front().stamp;
+    fusion::StateVector x = r.estimates.front().pose.vector();
+    std::optional<std::pair<double, double>> last;
+    for (const auto& w : log.wheels) {
+      if (w.value.stamp < from) continue;
+      if (last)
+        x = fusion::predict_motion(x, w.value.left - last->first, w.value.right - last->second,
+                                   robot.semi_axis);
+      last = {w.value.left, w.value.right};
+      r.odometry.emplace_back(w.value.stamp, Pose2(x.x(), x.y(), wrap_angle(x.z())));
+    }
+  } else {
+    r.notes.push_back("the robot was never localized");
+  }
+  score(r, log);
+  r.metrics.realtime_factor =
+      r.metrics.runtime_s > 0 ? r.metrics.duration_s / r.metrics.runtime_s : 0.0;
+  return r;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Outputs.
+
+io::SceneUpdate map_scene(const graph::TopologicalMap& map, Stamp stamp) {
+  io::SceneUpdate u;
+  u.stamp = stamp;
+  io::SceneEntity regions{"regions", {}, {}, {}}, graph_e{"graph", {}, {}, {}},
+      lamps{"lamps", {}, {}, {}};
+  for (const auto& n : map.nodes()) {
+    if (n.region.size() >= 3) {
+      io::SceneLine l;
+      for (const auto& v : n.region.vertices()) l.points.emplace_back(v.x(), v.y(), 0.0);
+      l.points.emplace_back(n.region.vertices().front().x(), n.region.vertices().front().y(), 0.0);
+      l.color = {0.55, 0.6, 0.7, 1.0};
+      l.thickness = 0.04;
+      regions.lines.push_back(std::move(l));
+    }
+    if (n.axis) {
+      io::SceneLine l;
+      l.points = {{n.axis->first.x(), n.axis->first.y(), 0.01},
+                  {n.axis->second.x(), n.axis->second.y(), 0.01}};
+      l.color = {0.3, 0.5, 0.9, 1.0};
+      l.thickness = 0.03;
+      graph_e.lines.push_back(std::move(l));
+    }
+    graph_e.texts.push_back({{n.point.x(), n.point.y(), 0.2}, n.name, {0.1, 0.1, 0.1, 1.0}, 0.4});
+    for (const auto& lamp : n.lamps)
+      lamps.cubes.push_back({lamp.xyz,
+                             {std::max(0.05, lamp.length), std::max(0.05, lamp.width), 0.05},
+                             lamp.yaw,
+                             {1.0, 0.8, 0.1, 1.0}});
+  }
+  for (const auto& e : map.edges()) {
+    io::SceneLine l;
+    for (const auto& part : e.geometry)
+      for (const auto& p : part) l.points.emplace_back(p.x(), p.y(), 0.02);
+    if (l.points.size() < 2) continue;
+    l.color = {0.4, 0.4, 0.4, 0.8};
+    l.thickness = 0.02;
+    graph_e.lines.push_back(std::move(l));
+  }
+  u.entities = {std::move(regions), std::move(graph_e), std::move(lamps)};
+  return u;
+}
+
+std::string tum(const std::vector<std::pair<Stamp, Pose2>>& poses) {
+  std::string out;
+  char line[160];
+  for (const auto& [t, p] : poses) {
+    std::snprintf(line, sizeof line, "%.9f %.6f %.6f 0 0 0 %.9f %.9f\n", to_seconds(t), p.x(),
+                  p.y(), std::sin(p.yaw() / 2), std::cos(p.yaw() / 2));
+    out += line;
+  }
+  return out;
+}
+
+std::string metrics_json(const Metrics& m) {
+  using Json = nlohmann::ordered_json;
+  auto err = [&](const ErrorStats& s) -> Json {
+    if (!m.has_truth || s.n == 0) return nullptr;
+    return Json{{"mean", s.mean}, {"rms", s.rms}, {"max", s.max}, {"samples", s.n}};
+  };
+  Json j;
+  j["frames"] = m.frames;
+  j["ceiling_frames"] = m.ceiling_frames;
+  j["omni_frames"] = m.omni_frames;
+  j["duration_s"] = m.duration_s;
+  j["has_truth"] = m.has_truth;
+  j["position_error_m"] = err(m.position_error_m);
+  j["yaw_error_deg"] = err(m.yaw_error_deg);
+  j["lost_s"] = m.lost_s;
+  j["kidnaps"] = m.kidnaps;
+  j["recoveries"] = m.recoveries;
+  j["relocalization_latency_s"] =
+      m.relocalization_latency_s.n
+          ? Json{{"mean", m.relocalization_latency_s.mean}, {"max", m.relocalization_latency_s.max}}
+          : Json(nullptr);
+  j["lamps_seen"] = m.lamps_seen;
+  j["lamps_labelled"] = m.lamps_labelled;
+  j["runtime_s"] = m.runtime_s;
+  j["realtime_factor"] = m.realtime_factor;
+  return j.dump(2) + "\n";
+}
+
+namespace {
+
+void write_text(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out) throw InputError({path, "", ""}, "cannot write the file");
+  out << text;
+  if (!out) throw InputError({path, "", ""}, "write failed");
+}
+
+const char* mode_name(fusion::LocalizerMode m) { return fusion::to_string(m); }
+
+}  // namespace
+
+void write_replay(const ReplayResult& r, const io::MissionLog& log,
+                  const graph::TopologicalMap& map, const std::string& map_geojson,
+                  const std::string& robot_json, const std::string& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError({dir, "", ""}, "cannot create the output directory: " + ec.message());
+  {
+    io::MissionLogWriter w(dir + "/replay.mcap");
+    w.attach_robot(robot_json);
+    w.attach_map(map_geojson);
+    for (const auto& m : log.commands) w.write(m.log_time, m.value);
+    for (const auto& m : log.events) w.write(m.log_time, m.value);
+    w.write(log.wheels.empty() ? Stamp{} : log.wheels.front().log_time,
+            map_scene(map, log.wheels.empty() ? Stamp{} : log.wheels.front().value.stamp));
+    for (const auto& m : log.wheels) w.write(m.log_time, m.value);
+    for (const auto& m : log.truth) w.write(m.log_time, m.value);
+    for (const auto& m : log.ceiling_images) w.write_image(m.log_time, m.value);
+    for (const auto& m : log.omni_images) w.write_image(m.log_time, m.value);
+    for (const auto& e : r.estimates) {
+      io::PoseEstimate p;
+      p.stamp = e.stamp;
+      p.pose = e.pose;
+      for (int k = 0; k < 9; ++k) p.covariance[k] = e.covariance(k / 3, k % 3);
+      p.node = e.node;
+      p.mode = mode_name(e.mode);
+      w.write(e.stamp, p);
+    }
+    for (const auto& f : r.lamp_frames) w.write(f.arrival, f.observations);
+    w.close();
+  }
+  std::vector<std::pair<Stamp, Pose2>> est;
+  for (const auto& e : r.estimates) est.emplace_back(e.stamp, e.pose);
+  write_text(dir + "/estimate.tum", tum(est));
+  if (!log.truth.empty()) {
+    const io::TruthTrack truth(log.truth);
+    std::vector<std::pair<Stamp, Pose2>> t;
+    for (const auto& s : truth.samples()) t.emplace_back(s.value.stamp, s.value.pose);
+    write_text(dir + "/truth.tum", tum(t));
+  }
+  write_text(dir + "/metrics.json", metrics_json(r.metrics));
+}
+
+}  // namespace lampnav::navigation
