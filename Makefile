@@ -20,15 +20,11 @@ configure: deps
 build: configure
 	@cmake --build $(BUILD_DIR) -j $(JOBS)
 
-# The main job. Until the mission runner exists, the job is: validate and draw the default map,
-# then plan a route across it and print the route commands.
+# The main job: the office mission in simulation, driven by route commands, kidnapped halfway,
+# relocalized by the omni camera, arriving; its log, replay outputs and report in $(OUT)/.
 demo: build
-	@mkdir -p $(OUT)
-	$(LAMPNAV) map check maps/office_floor.geojson
-	$(LAMPNAV) map render maps/office_floor.geojson -o $(OUT)/office_floor.png
-	$(LAMPNAV) map render maps/office_floor.geojson -o $(OUT)/office_floor.svg
-	$(LAMPNAV) route maps/office_floor.geojson --from E1 --to D6
-	@echo "drawings written to $(OUT)/" >&2
+	$(LAMPNAV) run --out $(OUT)
+	@echo "open $(OUT)/report.html" >&2
 
 # The official TypeScript MCAP reader, for the interoperability test (npm registry, pinned by the
 # lock file).

@@ -29,11 +29,6 @@ struct SimArgs {
   std::optional<double> ceiling_delay, omni_delay;
 };
 
-std::string data_path(const std::string& relative) {
-  const char* env = std::getenv("LAMPNAV_DATA_DIR");
-  return std::string(env && *env ? env : LAMPNAV_DATA_DIR) + "/" + relative;
-}
-
 int run_sim(const SimArgs& a) {
   if (a.scenario.empty() == a.route.empty()) {
     throw InputError({"", "", a.scenario.empty() ? "--route" : "--scenario"},
@@ -76,15 +71,10 @@ int run_sim(const SimArgs& a) {
   if (a.ceiling_delay) s.ceiling_delay_s = *a.ceiling_delay;
   if (a.omni_delay) s.omni_delay_s = *a.omni_delay;
 
-  const bool show = !a.quiet && ::isatty(2);
+  ProgressBar bar(a.quiet);
   const auto start = std::chrono::steady_clock::now();
-  const auto stats = sim::record_mission(s, a.out, [&](double f) {
-    if (!show) return;
-    const int w = 40, filled = static_cast<int>(f * w);
-    std::cerr << "\r[" << std::string(filled, '#') << std::string(w - filled, ' ') << "] "
-              << static_cast<int>(f * 100) << "% " << std::flush;
-  });
-  if (show) std::cerr << "\n";
+  const auto stats = sim::record_mission(s, a.out, [&](double f) { bar.update(f, "recording"); });
+  bar.done();
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   std::cout << "scenario: " << s.name << " (seed " << a.seed << ")\n"

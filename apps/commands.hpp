@@ -19,6 +19,22 @@ void add_map_commands(CLI::App& app, Job& run);
 void add_route_command(CLI::App& app, Job& run);
 void add_sim_command(CLI::App& app, Job& run);
 void add_locate_command(CLI::App& app, Job& run);
+void add_run_commands(CLI::App& app, Job& run);  // run, replay
+
+// A bundled file (maps/..., maps/robots/...): under $LAMPNAV_DATA_DIR, or the source tree.
+std::string data_path(const std::string& relative);
+
+// A progress bar on stderr, drawn only when stderr is a terminal and not `quiet`.
+class ProgressBar {
+ public:
+  explicit ProgressBar(bool quiet);
+  void update(double fraction, const std::string& what = {});
+  void done();
+
+ private:
+  bool show_;
+  int last_ = -1;
+};
 
 // Prints a diagnostic line to stderr: "lampnav: <kind>: <text>".
 void diagnostic(const std::string& kind, const std::string& text);

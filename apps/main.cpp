@@ -1,7 +1,11 @@
 // lampnav: one program, subcommands as in shared/spec/cli.md. Exit status 0 success, 1 the job ran
 // and failed, 2 bad input or usage. Only results go to stdout; diagnostics go to stderr.
 
+#include <unistd.h>
+
 #include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdlib>
 #include <iostream>
 
 #include "commands.hpp"
@@ -10,6 +14,28 @@
 namespace lampnav::apps {
 void diagnostic(const std::string& kind, const std::string& text) {
   std::cerr << "lampnav: " << kind << ": " << text << "\n";
+}
+
+std::string data_path(const std::string& relative) {
+  const char* env = std::getenv("LAMPNAV_DATA_DIR");
+  return std::string(env && *env ? env : LAMPNAV_DATA_DIR) + "/" + relative;
+}
+
+ProgressBar::ProgressBar(bool quiet) : show_(!quiet && ::isatty(2)) {}
+
+void ProgressBar::update(double fraction, const std::string& what) {
+  if (!show_) return;
+  const int percent = static_cast<int>(std::clamp(fraction, 0.0, 1.0) * 100);
+  if (percent == last_) return;
+  last_ = percent;
+  const int w = 40, filled = percent * w / 100;
+  std::cerr << "\r[" << std::string(filled, '#') << std::string(w - filled, ' ') << "] " << percent
+            << "% " << what << "\033[K" << std::flush;
+}
+
+void ProgressBar::done() {
+  if (show_ && last_ >= 0) std::cerr << "\n";
+  last_ = -1;
 }
 }  // namespace lampnav::apps
 
@@ -23,6 +49,7 @@ int main(int argc, char** argv) {
   apps::add_route_command(app, run);
   apps::add_sim_command(app, run);
   apps::add_locate_command(app, run);
+  apps::add_run_commands(app, run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

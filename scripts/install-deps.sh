@@ -10,8 +10,8 @@ packages=(
   # libraries
   libeigen3-dev libboost-graph-dev libopencv-dev libvisp-dev nlohmann-json3-dev libcli11-dev
   libcairo2-dev libzstd-dev
-  # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev
+  # tests and benchmarks; Chromium opens the report headless in a test
+  libgtest-dev libgmock-dev libbenchmark-dev chromium
 )
 # Node.js and npm run the MCAP interoperability test (@mcap/core). A machine that already has
 # them (from any source) keeps its own.
