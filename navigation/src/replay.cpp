@@ -38,21 +38,41 @@ LogRobot::LogRobot(const io::MissionLog& log, bool use_ceiling, bool use_omni) :
   });
 }
 
+LogRobot::Decoded LogRobot::decode(const Item& it) const {
+  const auto& f = (it.kind == 1 ? log_->ceiling_images : log_->omni_images)[it.index];
+  try {
+    return {io::decode_image(f.value.data, f.value.frame_id), {}};
+  } catch (const InputError& e) {
+    return {std::nullopt, std::string(it.kind == 1 ? "ceiling" : "omni") + " frame captured at " +
+                              std::to_string(to_seconds(f.value.stamp)) + " s: " + e.message()};
+  }
+}
+
 std::optional<RobotInput> LogRobot::next() {
+  constexpr std::size_t kAhead = 4;
   while (next_ < items_.size()) {
-    const Item& it = items_[next_++];
+    // Keep up to kAhead frames decoding ahead of the loop.
+    while (ahead_.size() < kAhead && launched_ < items_.size()) {
+      const std::size_t k = launched_++;
+      if (items_[k].kind == 0) continue;
+      ahead_.emplace_back(k,
+                          std::async(std::launch::async, [this, k] { return decode(items_[k]); }));
+    }
+    const std::size_t k = next_++;
+    const Item& it = items_[k];
     if (it.kind == 0) {
       const auto& w = log_->wheels[it.index];
       return WheelInput{w.value.stamp, w.value.left, w.value.right};
     }
-    const auto& f = (it.kind == 1 ? log_->ceiling_images : log_->omni_images)[it.index];
-    try {
-      return FrameInput{it.kind == 1 ? CameraRole::ceiling : CameraRole::omni, f.value.stamp,
-                        f.log_time, io::decode_image(f.value.data, f.value.frame_id)};
-    } catch (const InputError& e) {
-      problems_.push_back(std::string(it.kind == 1 ? "ceiling" : "omni") + " frame captured at " +
-                          std::to_string(to_seconds(f.value.stamp)) + " s: " + e.message());
+    Decoded d = ahead_.front().second.get();  // frames are launched in item order
+    ahead_.pop_front();
+    if (!d.image) {
+      problems_.push_back(d.problem);
+      continue;
     }
+    const auto& f = (it.kind == 1 ? log_->ceiling_images : log_->omni_images)[it.index];
+    return FrameInput{it.kind == 1 ? CameraRole::ceiling : CameraRole::omni, f.value.stamp,
+                      f.log_time, std::move(*d.image)};
   }
   return std::nullopt;
 }

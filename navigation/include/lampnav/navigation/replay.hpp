@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 #include <deque>
+#include <future>
 #include <optional>
 #include <string>
 #include <vector>
@@ -33,9 +34,19 @@ class LogRobot : public Robot {
     int kind;  // 0 wheels, 1 ceiling, 2 omni
     std::size_t index;
   };
+  struct Decoded {
+    std::optional<Image8> image;
+    std::string problem;
+  };
+  Decoded decode(const Item& it) const;
+
   const io::MissionLog* log_;
   std::vector<Item> items_;
   std::size_t next_ = 0;
+  // Frames decode on other threads a few items ahead of the loop (PNG decoding is most of a
+  // replay's time); the results are the same whatever the timing.
+  std::deque<std::pair<std::size_t, std::future<Decoded>>> ahead_;
+  std::size_t launched_ = 0;  // items_ before this have had their decoding started (or are wheels)
   std::vector<std::string> problems_;
 };
 
