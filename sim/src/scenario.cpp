@@ -160,13 +160,6 @@ Scenario make_named_scenario(const std::string& name, const graph::TopologicalMa
 
 namespace {
 
-std::string put_down_detail(const Pose2& pose) {
-  char detail[96];
-  std::snprintf(detail, sizeof detail, "put down at (%.2f, %.2f, %.1f deg)", pose.x(), pose.y(),
-                pose.yaw() / kDeg);
-  return detail;
-}
-
 // Points every `step` metres along a polyline, with the heading of the segment they lie on.
 std::vector<Pose2> resample(const std::vector<Vector2d>& pts, double step) {
   std::vector<Pose2> out;
@@ -225,7 +218,7 @@ RecordStats record_mission(const Scenario& s, const std::string& path,
       if (kidnap_index < s.kidnaps.size() && t_s >= s.kidnaps[kidnap_index].at_s) {
         const Kidnap& k = s.kidnaps[kidnap_index++];
         const Pose2 to = k.to ? *k.to : world.random_place();
-        world.put_down(to, put_down_detail(to));
+        world.put_down(to);
         // The person at the joystick drives on to the goal from where the robot now stands.
         std::vector<Vector2d> pts{to.translation()};
         if (!s.goal.empty()) {

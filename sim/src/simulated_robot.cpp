@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "world.hpp"
 
@@ -32,11 +31,7 @@ std::optional<navigation::RobotInput> SimulatedRobot::next() {
     if (next_kidnap_ < scenario_.kidnaps.size() &&
         world_->now_ns() * 1e-9 >= scenario_.kidnaps[next_kidnap_].at_s) {
       const Kidnap& k = scenario_.kidnaps[next_kidnap_++];
-      const Pose2 to = k.to ? *k.to : world_->random_place();
-      char detail[96];
-      std::snprintf(detail, sizeof detail, "put down at (%.2f, %.2f, %.1f deg)", to.x(), to.y(),
-                    to.yaw() * 180 / M_PI);
-      world_->put_down(to, detail);
+      world_->put_down(k.to ? *k.to : world_->random_place());
     }
     // The commanded wheel speeds move the true wheels (the true semi-axis turns the body).
     const double a = world_->true_semi_axis();

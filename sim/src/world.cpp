@@ -1,6 +1,7 @@
 #include "world.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "lampnav/core/error.hpp"
 
@@ -135,7 +136,10 @@ void World::place(const Pose2& pose) { pose_ = pose; }
 void World::put_down(const Pose2& pose, const std::string& detail) {
   pose_ = pose;
   const Stamp t = stamp_from_nanoseconds(t_ns_);
-  log_.write(t, io::MissionEvent{t, "kidnap", detail});
+  char where[96];
+  std::snprintf(where, sizeof where, "put down at (%.2f, %.2f, %.1f deg)", pose.x(), pose.y(),
+                pose.yaw() * 180 / M_PI);
+  log_.write(t, io::MissionEvent{t, "kidnap", detail.empty() ? where : detail});
   ++stats_.kidnaps;
 }
 

@@ -44,8 +44,9 @@ class World {
   void advance();
   // Where the robot starts (no event).
   void place(const Pose2& pose);
-  // Lifted and put down (a kidnap event in the log); odometry knows nothing of it.
-  void put_down(const Pose2& pose, const std::string& detail);
+  // Lifted and put down (a kidnap event in the log, saying where, or `detail`); odometry knows
+  // nothing of it.
+  void put_down(const Pose2& pose, const std::string& detail = {});
   // A frame from each camera that the scenario has, now.
   void capture_all();
   // The frames that have arrived by `until_ns`, written to the log and handed out in order.
