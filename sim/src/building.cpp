@@ -1,0 +1,171 @@
+#include "lampnav/sim/building.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <vector>
+
+#include "lampnav/core/error.hpp"
+
+namespace lampnav::sim {
+
+using Json = nlohmann::ordered_json;
+
+void BuildingOptions::validate() const {
+  auto check = [](bool ok, const char* field, const char* what) {
+    if (!ok) throw InputError({"", "building", field}, what);
+  };
+  check(nodes >= 8 && nodes <= 200000, "nodes", "must be 8 to 200000");
+  check(block_m >= 8 && block_m <= 200, "block_m", "must be 8 to 200 m");
+  check(lamp_spacing_m >= 0.5 && lamp_spacing_m < block_m, "lamp_spacing_m",
+        "must be at least 0.5 m and less than a block");
+  check(ceiling_m > 1 && ceiling_m < 50, "ceiling_m", "must be 1 to 50 m");
+}
+
+namespace {
+
+struct Writer {
+  Json features = Json::array();
+  int next_id = 1, next_edge = 1000000, lamps = 0, edges = 0;
+  std::map<std::string, int> ids;
+  std::map<std::string, std::pair<double, double>> points;
+
+  static Json region(double x0, double y0, double x1, double y1) {
+    return {{"x_values", {x0, x1, x1, x0}}, {"y_values", {y0, y0, y1, y1}}};
+  }
+  Json& node(const std::string& name, const char* place, double x, double y, Json region_json) {
+    ids[name] = next_id;
+    points[name] = {x, y};
+    Json md = {{"name", name}, {"place", place}};
+    md["region"] = std::move(region_json);
+    md["lamps"] = Json::array();
+    features.push_back({{"type", "Feature"},
+                        {"geometry", {{"type", "Point"}, {"coordinates", {x, y}}}},
+                        {"properties", {{"id", next_id++}, {"frame", "map"}, {"metadata", md}}}});
+    return features.back()["properties"]["metadata"];
+  }
+  void lamp(Json& md, const std::string& id, double x, double y, double z, double yaw, bool disc) {
+    Json l = {{"id", id}, {"xyz", {x, y, z}}};
+    if (disc) {
+      l["shape"] = "disc";
+      l["size"] = {0.6};
+    } else {
+      l["yaw"] = yaw;
+      l["shape"] = "rectangle";
+      l["size"] = {1.2, 0.3};
+    }
+    md["lamps"].push_back(std::move(l));
+    ++lamps;
+  }
+  void link(const std::string& a, const std::string& b) {
+    for (const auto& [s, e] : {std::pair{a, b}, std::pair{b, a}}) {
+      const auto [sx, sy] = points.at(s);
+      const auto [ex, ey] = points.at(e);
+      features.push_back(
+          {{"type", "Feature"},
+           {"geometry", {{"type", "MultiLineString"}, {"coordinates", {{{sx, sy}, {ex, ey}}}}}},
+           {"properties",
+            {{"id", next_edge++},
+             {"startid", ids.at(s)},
+             {"endid", ids.at(e)},
+             {"metadata", Json::object()}}}});
+      ++edges;
+    }
+  }
+};
+
+}  // namespace
+
+Building generate_building(const BuildingOptions& o) {
+  o.validate();
+  // The largest grid whose junctions and corridors fit, then rooms (with their doors) to the count.
+  int k = 2;
+  auto base = [](int g) { return g * g + 2 * g * (g - 1); };
+  while (base(k + 1) <= o.nodes) ++k;
+  const int blocks = (k - 1) * (k - 1);
+  const int rooms = std::min(blocks, (o.nodes - base(k)) / 2);
+  const double S = o.block_m, z = o.ceiling_m;
+  Writer w;
+  auto J = [](int i, int j) { return "J" + std::to_string(i) + "_" + std::to_string(j); };
+  auto H = [](int i, int j) { return "H" + std::to_string(i) + "_" + std::to_string(j); };
+  auto V = [](int i, int j) { return "V" + std::to_string(i) + "_" + std::to_string(j); };
+  for (int i = 0; i < k; ++i)
+    for (int j = 0; j < k; ++j) {
+      const bool corner = (i == 0 || i == k - 1) && (j == 0 || j == k - 1);
+      const double x = i * S, y = j * S;
+      Json& md = w.node(J(i, j), corner ? "corner" : "junction", x, y,
+                        Writer::region(x - 1, y - 1, x + 1, y + 1));
+      w.lamp(md, J(i, j) + "-L1", x, y, z, 0.0, false);
+    }
+  // Which blocks have a room: a seeded shuffle, so sizes between grids spread them out.
+  std::vector<int> order(blocks);
+  for (int b = 0; b < blocks; ++b) order[b] = b;
+  std::mt19937_64 rng(o.seed);
+  std::shuffle(order.begin(), order.end(), rng);
+  std::vector<char> has_room(blocks, 0);
+  for (int r = 0; r < rooms; ++r) has_room[order[r]] = 1;
+  auto corridor = [&](const std::string& name, double x0, double y0, double x1, double y1,
+                      bool room_door) {
+    const bool horizontal = y0 == y1;
+    const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
+    Json& md = w.node(name, "corridor", cx, cy,
+                      horizontal ? Writer::region(x0, y0 - 1, x1, y0 + 1)
+                                 : Writer::region(x0 - 1, y0, x0 + 1, y1));
+    md["axis"] = {{x0, y0}, {x1, y1}};
+    md["width"] = 2.0;
+    const double len = std::hypot(x1 - x0, y1 - y0);
+    const int n = static_cast<int>(std::floor(len / o.lamp_spacing_m));
+    const double first = 0.5 * (len - (n - 1) * o.lamp_spacing_m);
+    for (int q = 0; q < n; ++q) {
+      const double s = first + q * o.lamp_spacing_m;
+      w.lamp(md, name + "-L" + std::to_string(q + 1), horizontal ? x0 + s : x0,
+             horizontal ? y0 : y0 + s, z, horizontal ? 0.0 : M_PI / 2, false);
+    }
+    if (room_door)
+      md["doors"] = Json::array({{{"name", "D" + name}, {"side", "left"}, {"at", 0.5 * len}}});
+    return horizontal;
+  };
+  for (int i = 0; i + 1 < k; ++i)
+    for (int j = 0; j < k; ++j) {
+      const bool room = j + 1 < k && has_room[i * (k - 1) + j];
+      corridor(H(i, j), i * S + 1, j * S, (i + 1) * S - 1, j * S, room);
+      w.link(J(i, j), H(i, j));
+      w.link(H(i, j), J(i + 1, j));
+      if (!room) continue;
+      // The room north of the corridor (its left, going east), through a door at its middle.
+      const double x = (i + 0.5) * S, y = j * S;
+      w.node("D" + H(i, j), "door", x, y + 1.15, Writer::region(x - 0.5, y + 1, x + 0.5, y + 1.3));
+      const std::string room_name = "R" + std::to_string(i) + "_" + std::to_string(j);
+      const double rx0 = i * S + 2, rx1 = (i + 1) * S - 2, ry0 = y + 1.3, ry1 = y + 0.5 * S;
+      Json& md = w.node(room_name, "room", 0.5 * (rx0 + rx1), 0.5 * (ry0 + ry1),
+                        Writer::region(rx0, ry0, rx1, ry1));
+      for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b)
+          w.lamp(md, room_name + "-L" + std::to_string(4 * a + b + 1),
+                 rx0 + (a + 0.5) * (rx1 - rx0) / 4, ry0 + (b + 0.5) * (ry1 - ry0) / 4, z, 0.0,
+                 true);
+      w.link(H(i, j), "D" + H(i, j));
+      w.link("D" + H(i, j), room_name);
+    }
+  for (int i = 0; i < k; ++i)
+    for (int j = 0; j + 1 < k; ++j) {
+      corridor(V(i, j), i * S, j * S + 1, i * S, (j + 1) * S - 1, false);
+      w.link(J(i, j), V(i, j));
+      w.link(V(i, j), J(i, j + 1));
+    }
+  Building b;
+  b.grid = k;
+  b.nodes = static_cast<int>(w.ids.size());
+  b.edges = w.edges;
+  b.lamps = w.lamps;
+  Json doc = {{"type", "FeatureCollection"},
+              {"name", "generated-" + std::to_string(b.nodes)},
+              {"lampnav", {{"format", 1}, {"units", "m"}, {"frame", "map"}}},
+              {"features", std::move(w.features)}};
+  b.geojson = doc.dump();
+  return b;
+}
+
+}  // namespace lampnav::sim
