@@ -11,7 +11,10 @@
 #include "lampnav/fusion/global_localizer.hpp"
 #include "lampnav/fusion/merit.hpp"
 #include "lampnav/graph/geojson.hpp"
+#include "lampnav/sim/building.hpp"
 #include "lampnav/sim/renderers.hpp"
+
+#include <map>
 
 namespace {
 
@@ -139,6 +142,61 @@ void BM_GlobalLocalizationDefault(benchmark::State& state) {
   locate(state, fusion::GlobalMethod::lamp_pairs);
 }
 BENCHMARK(BM_GlobalLocalizationDefault)->Unit(benchmark::kMillisecond);
+
+// Global localization restricted by the graph on generated buildings (office lamps 0.9 m above
+// the omni camera): views from along the corridors, detected once. Target: 50 ms at 1,000 nodes.
+struct BuildingViews {
+  graph::TopologicalMap map;
+  RobotDescription robot;
+  std::vector<vision::OmniDetection> detections;
+  int lamps = 0;
+  explicit BuildingViews(int nodes) {
+    sim::BuildingOptions bo;
+    bo.nodes = nodes;
+    const sim::Building b = sim::generate_building(bo);
+    lamps = b.lamps;
+    map = graph::parse_map(b.geojson, "generated").map;
+    robot = read_robot_description(std::string(LAMPNAV_SOURCE_DIR) + "/maps/robots/pioneer.json");
+    const CameraDescription& cam = *robot.find_camera("omni_camera");
+    std::vector<const graph::Lamp*> all;
+    std::vector<const graph::Node*> corridors;
+    for (const auto& n : map.nodes()) {
+      if (n.axis) corridors.push_back(&n);
+      for (const auto& l : n.lamps) all.push_back(&l);
+    }
+    const sim::OmniRenderer renderer(cam, sim::OmniRenderOptions{});
+    vision::OmniLampDetector detector(cam);
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(0, 1);
+    while (detections.size() < 10) {
+      const graph::Node& c = *corridors[rng() % corridors.size()];
+      const Pose2 pose(c.axis->point_at(u(rng) * c.axis->length()), 2 * M_PI * u(rng));
+      const Image8 img = renderer.render(pose, {}, map.lamps_within(pose.translation(), 30.0), rng);
+      detections.push_back(detector.detect(vision::ImageView::of(img)));
+    }
+  }
+};
+
+void BM_GlobalLocalizationBuilding(benchmark::State& state) {
+  static std::map<int, BuildingViews> cache;
+  const int nodes = static_cast<int>(state.range(0));
+  auto it = cache.find(nodes);
+  if (it == cache.end()) it = cache.emplace(nodes, BuildingViews(nodes)).first;
+  const BuildingViews& b = it->second;
+  const fusion::GlobalLocalizer global(b.map, *b.robot.find_camera("omni_camera"));
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const auto r = global.locate(b.detections[k++ % b.detections.size()]);
+    benchmark::DoNotOptimize(r.hypotheses.data());
+  }
+  state.counters["nodes"] = nodes;
+  state.counters["lamps"] = b.lamps;
+}
+BENCHMARK(BM_GlobalLocalizationBuilding)
+    ->Arg(10)
+    ->Arg(100)
+    ->Arg(1000)
+    ->Unit(benchmark::kMillisecond);
 
 // One merit evaluation (Alg. 1 + Alg. 2) at a random pose.
 void BM_MeritEvaluation(benchmark::State& state) {

@@ -7,6 +7,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <sstream>
 
 #include "global_localizer_impl.hpp"
@@ -78,6 +79,65 @@ GlobalLocalizer::Impl::Impl(const graph::TopologicalMap& m, const CameraDescript
     region_cdf.push_back(total);
   }
   has_regions = !regions.empty();
+  index_lamps();
+}
+
+void GlobalLocalizer::Impl::index_lamps() {
+  const LampPairOptions& q = o.pairs;
+  std::map<std::pair<long, long>, int> class_ids;
+  double max_height = 0;
+  for (std::size_t i = 0; i < lamps.size(); ++i) {
+    lamp_index[lamps[i]] = static_cast<int>(i);
+    const double h = lamps[i]->xyz.z() - mount_t.z();
+    max_height = std::max(max_height, h);
+    const std::pair<long, long> key{std::lround(h / 0.05), std::lround(lamps[i]->length / 0.05)};
+    auto it = class_ids.find(key);
+    if (it == class_ids.end()) {
+      it = class_ids.emplace(key, static_cast<int>(classes.size())).first;
+      classes.push_back({key.first * 0.05, key.second * 0.05});
+    }
+    class_of.push_back(it->second);
+  }
+  // Two seeds lie within pair_max_theta of the axis: no further apart than twice that reach.
+  const double offset = mount_t.head<2>().norm();
+  const double reach = max_height * std::tan(q.pair_max_theta_deg * kDeg) + offset;
+  std::map<std::pair<int, int>, std::vector<LampPair>> groups;
+  for (std::size_t i = 0; i < lamps.size(); ++i)
+    for (const graph::Lamp* other : map->lamps_within(lamps[i]->xyz.head<2>(), 2 * reach)) {
+      const int l = lamp_index.at(other);
+      if (l == static_cast<int>(i)) continue;
+      const Vector2d v = other->xyz.head<2>() - lamps[i]->xyz.head<2>();
+      const double d = v.norm();
+      if (d < 0.2) continue;  // too close to give a heading
+      groups[{class_of[i], class_of[l]}].push_back(
+          {d, std::atan2(v.y(), v.x()), static_cast<int>(i), l});
+    }
+  for (auto& [key, v] : groups) {
+    std::sort(v.begin(), v.end(), [](const LampPair& a, const LampPair& b) {
+      return a.distance < b.distance ||
+             (a.distance == b.distance && (a.a < b.a || (a.a == b.a && a.b < b.b)));
+    });
+    pair_groups.emplace_back(key, std::move(v));
+  }
+  // Lamps further off the axis than max_theta are not scored; the margin covers the lamp's own
+  // size and a pose off by a metre.
+  double longest = 0;
+  for (const auto* l : lamps) longest = std::max(longest, l->length);
+  const double theta = std::min(q.max_theta_deg * kDeg, 89.5 * kDeg);
+  view_radius = max_height * std::tan(theta) + offset + longest + 1.0;
+}
+
+std::vector<int> GlobalLocalizer::Impl::lamps_in_view(const Pose2& pose) const {
+  std::vector<int> out;
+  if (lamps.size() <= 256) {
+    out.resize(lamps.size());
+    for (std::size_t i = 0; i < lamps.size(); ++i) out[i] = static_cast<int>(i);
+    return out;
+  }
+  for (const graph::Lamp* l : map->lamps_within(pose.translation(), view_radius))
+    out.push_back(lamp_index.at(l));
+  std::sort(out.begin(), out.end());  // the map's order, so that results do not depend on the index
+  return out;
 }
 
 Vector3d GlobalLocalizer::Impl::camera_point(const Pose2& pose, const Vector3d& lamp,
@@ -117,7 +177,7 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     bool crowded = false, matched = false;
   };
   std::vector<Predicted> pred;
-  for (std::size_t i = 0; i < lamps.size(); ++i) {
+  for (const int i : lamps_in_view(pose)) {
     const Vector3d c = camera_point(pose, lamps[i]->xyz, tilt);
     const double range = c.norm();
     if (!(range > 0.1)) continue;

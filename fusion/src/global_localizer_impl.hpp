@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <cmath>
 #include <limits>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -90,14 +91,35 @@ struct GlobalLocalizer::Impl {
   std::vector<double> region_cdf;
   bool has_regions = false;
 
+  // Lamps in classes of one height above the camera and one length (5 cm steps): a blob puts
+  // every lamp of a class at the same place in the robot's frame.
+  struct LampClass {
+    double height, length;
+  };
+  std::vector<LampClass> classes;
+  std::vector<int> class_of;  // per lamp
+  // Ordered pairs of lamps close enough to be seen together as seeds, grouped by their classes
+  // and sorted by horizontal distance: a pair of blobs looks up the pairs spaced like it.
+  struct LampPair {
+    double distance, angle;  // of b from a, horizontal
+    int a, b;
+  };
+  std::vector<std::pair<std::pair<int, int>, std::vector<LampPair>>> pair_groups;
+  // The lamps a pose can see (within max_theta), found through the map's spatial index on big
+  // maps; on small ones all of them.
+  std::unordered_map<const graph::Lamp*, int> lamp_index;
+  double view_radius = 0;
+  void index_lamps();
+  std::vector<int> lamps_in_view(const Pose2& pose) const;
+
   Impl(const graph::TopologicalMap& m, const CameraDescription& camera,
        const GlobalLocalizerOptions& opt);
 
   const graph::Node* node_of(const Pose2& p) const { return map->node_containing(p.translation()); }
 
   // ---------------------------------------------------------------------------------------
-  // Scoring a pose. The lamp in the camera frame from a robot pose, the base tilted by the floor (roll about
-  // x, then pitch about y, as conventions.md orders roll-pitch-yaw).
+  // Scoring a pose. The lamp in the camera frame from a robot pose, the base tilted by the floor
+  // (roll about x, then pitch about y, as conventions.md orders roll-pitch-yaw).
   Vector3d camera_point(const Pose2& pose, const Vector3d& lamp, const Tilt& tilt = {}) const;
 
   std::vector<BlobRay> blob_rays(const vision::OmniDetection& d, double max_theta) const;

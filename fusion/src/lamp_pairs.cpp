@@ -31,54 +31,57 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
               " degrees of the optical axis: a pose needs two";
     return out;
   }
-  // Where each seed puts each lamp, in the base frame, were it that lamp.
+  // Where each seed puts a lamp of each class, in the base frame, were it one.
   const double sa = std::hypot(q.detection_sigma_deg, q.tilt_sigma_deg) * kDeg;
-  const std::size_t nl = lamps.size(), ns = seeds.size();
-  std::vector<Vector2d> at(ns * nl);
-  std::vector<double> sigma(ns * nl, -1);
+  const std::size_t nc = classes.size(), ns = seeds.size();
+  std::vector<Vector2d> at(ns * nc);
+  std::vector<double> sigma(ns * nc, -1);
   for (std::size_t j = 0; j < ns; ++j) {
     const Vector3d rb = mount_R * seeds[j].ray;
-    for (std::size_t i = 0; i < nl; ++i) {
-      const double h = lamps[i]->xyz.z() - mount_t.z();
+    for (std::size_t c = 0; c < nc; ++c) {
+      const double h = classes[c].height;
       if (h < 0.2) continue;
-      const double s = h / rb.z();
-      at[j * nl + i] = mount_t.head<2>() + s * rb.head<2>();
-      const double sj = h * sa / (rb.z() * rb.z()) + 0.1 * lamps[i]->length;
+      at[j * nc + c] = mount_t.head<2>() + (h / rb.z()) * rb.head<2>();
+      const double sj = h * sa / (rb.z() * rb.z()) + 0.1 * classes[c].length;
       // A seed that puts the lamp no better than this says nothing of the pose.
-      if (sj <= 0.5) sigma[j * nl + i] = sj;
+      if (sj <= 0.5) sigma[j * nc + c] = sj;
     }
   }
-  // Vote: every pair of seeds matched to a pair of lamps at the same spacing is a pose.
+  // Vote: every pair of seeds matched to a pair of lamps at the same spacing is a pose. The
+  // lamp pairs come from the index, looked up by spacing.
   struct Cell {
     int votes = 0;
     double x = 0, y = 0, c = 0, s = 0;
   };
   std::unordered_map<std::int64_t, Cell> cells;
+  cells.reserve(4096);
   const double cell_m = 0.25, cell_rad = 3 * kDeg;
   for (std::size_t j = 0; j < ns; ++j)
     for (std::size_t k = j + 1; k < ns; ++k)
-      for (std::size_t i = 0; i < nl; ++i) {
-        if (sigma[j * nl + i] < 0) continue;
-        const Vector2d& qi = at[j * nl + i];
-        for (std::size_t l = 0; l < nl; ++l) {
-          if (l == i || sigma[k * nl + l] < 0) continue;
-          const Vector2d& ql = at[k * nl + l];
-          const Vector2d D = lamps[l]->xyz.head<2>() - lamps[i]->xyz.head<2>();
-          const Vector2d dq = ql - qi;
-          const double dn = dq.norm(), Dn = D.norm();
-          const double tol = 3 * std::hypot(sigma[j * nl + i], sigma[k * nl + l]) + 0.02;
-          if (std::abs(dn - Dn) > tol || Dn < 0.2) continue;
-          const double yaw = wrap_angle(std::atan2(D.y(), D.x()) - std::atan2(dq.y(), dq.x()));
+      for (const auto& [key, group] : pair_groups) {
+        const double sj = sigma[j * nc + key.first], sk = sigma[k * nc + key.second];
+        if (sj < 0 || sk < 0) continue;
+        const Vector2d& qi = at[j * nc + key.first];
+        const Vector2d& ql = at[k * nc + key.second];
+        const Vector2d dq = ql - qi;
+        const double dn = dq.norm();
+        const double dq_angle = std::atan2(dq.y(), dq.x());
+        const double tol = 3 * std::hypot(sj, sk) + 0.02;
+        auto lo = std::lower_bound(group.begin(), group.end(), dn - tol,
+                                   [](const LampPair& p, double v) { return p.distance < v; });
+        for (auto it = lo; it != group.end() && it->distance <= dn + tol; ++it) {
+          const Vector2d Li = lamps[it->a]->xyz.head<2>(), Ll = lamps[it->b]->xyz.head<2>();
+          const double yaw = wrap_angle(it->angle - dq_angle);
           const double c = std::cos(yaw), s = std::sin(yaw);
           const Vector2d mid_q = 0.5 * (qi + ql);
-          const Vector2d mid_L = 0.5 * (lamps[l]->xyz.head<2>() + lamps[i]->xyz.head<2>());
+          const Vector2d mid_L = 0.5 * (Li + Ll);
           const Vector2d p =
               mid_L - Vector2d(c * mid_q.x() - s * mid_q.y(), s * mid_q.x() + c * mid_q.y());
-          const std::int64_t key = (std::int64_t(std::floor(p.x() / cell_m)) * 1000003 +
-                                    std::int64_t(std::floor(p.y() / cell_m))) *
-                                       1009 +
-                                   std::int64_t(std::floor((yaw + M_PI) / cell_rad));
-          Cell& cell = cells[key];
+          const std::int64_t cell_key = (std::int64_t(std::floor(p.x() / cell_m)) * 1000003 +
+                                         std::int64_t(std::floor(p.y() / cell_m))) *
+                                            1009 +
+                                        std::int64_t(std::floor((yaw + M_PI) / cell_rad));
+          Cell& cell = cells[cell_key];
           ++cell.votes;
           cell.x += p.x();
           cell.y += p.y();
@@ -86,16 +89,22 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
           cell.s += s;
         }
       }
+  // The most voted cells, best first (ties by key, so that the result never depends on the hash
+  // map's order); only the few that can be scored are sorted.
+  std::vector<std::pair<int, std::int64_t>> ranked;
+  ranked.reserve(cells.size());
+  for (const auto& [key, cell] : cells) ranked.emplace_back(cell.votes, key);
+  auto better = [](const auto& a, const auto& b) {
+    return a.first != b.first ? a.first > b.first : a.second < b.second;
+  };
+  const std::size_t keep = std::min<std::size_t>(ranked.size(), 8 * q.candidates);
+  std::partial_sort(ranked.begin(), ranked.begin() + keep, ranked.end(), better);
   std::vector<std::pair<int, Pose2>> voted;
-  voted.reserve(cells.size());
-  for (const auto& [key, cell] : cells)
+  for (std::size_t r = 0; r < keep; ++r) {
+    const Cell& cell = cells.at(ranked[r].second);
     voted.emplace_back(cell.votes,
                        Pose2(cell.x / cell.votes, cell.y / cell.votes, std::atan2(cell.s, cell.c)));
-  std::sort(voted.begin(), voted.end(), [](const auto& a, const auto& b) {
-    if (a.first != b.first) return a.first > b.first;
-    const Vector3d u = a.second.vector(), v = b.second.vector();
-    return std::lexicographical_compare(u.data(), u.data() + 3, v.data(), v.data() + 3);
-  });
+  }
   // The graph: a robot stands in a node's region.
   std::vector<std::pair<double, Pose2>> scored;
   int outside = 0;
