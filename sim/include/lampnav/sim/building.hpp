@@ -9,9 +9,9 @@
 namespace lampnav::sim {
 
 struct BuildingOptions {
-  int nodes = 100;              // about this many nodes (exactly, when the grid allows it)
-  double block_m = 20.0;        // junction spacing
-  double lamp_spacing_m = 1.5;  // along corridors
+  int nodes = 100;               // about this many nodes (exactly, when the grid allows it)
+  double block_m = 20.0;         // junction spacing
+  double lamp_spacing_m = 2.25;  // along corridors, as on the office floor
   double ceiling_m = 2.7;
   std::uint64_t seed = 1;  // which blocks get rooms
   void validate() const;   // throws InputError naming the field

@@ -1,0 +1,239 @@
+// `make bench`'s one table: reads the JSON the benchmark programs wrote, prints case, ours, peer,
+// ratio and target, each row saying plainly whether its target is met, with how costs grow with the
+// building's size; writes the same as bench/results.json.
+//   bench_summary OUT.json BENCH.json...
+
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+struct Measure {
+  double us = 0;  // real time per iteration, microseconds
+  Json raw;
+};
+
+std::map<std::string, Measure> results;
+Json context;
+
+void read(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error("cannot read " + path);
+  const Json j = Json::parse(in);
+  if (context.is_null()) context = j["context"];
+  for (const auto& b : j["benchmarks"]) {
+    const std::string unit = b.value("time_unit", "ns");
+    const double f = unit == "ns" ? 1e-3 : unit == "us" ? 1.0 : unit == "ms" ? 1e3 : 1e6;
+    std::string name = b["name"];
+    // "BM_X/iterations:3/real_time" -> "BM_X"
+    for (const char* tail : {"/iterations:", "/real_time", "/min_time:"}) {
+      const auto p = name.find(tail);
+      if (p != std::string::npos) name = name.substr(0, p);
+    }
+    results[name] = {b["real_time"].get<double>() * f, b};
+  }
+}
+
+std::optional<double> us(const std::string& name) {
+  auto it = results.find(name);
+  if (it == results.end()) return std::nullopt;
+  return it->second.us;
+}
+
+std::string show(double v_us) {
+  std::ostringstream s;
+  s << std::setprecision(3);
+  if (v_us < 1)
+    s << v_us * 1000 << " ns";
+  else if (v_us < 1000)
+    s << v_us << " us";
+  else if (v_us < 1e6)
+    s << v_us / 1000 << " ms";
+  else
+    s << v_us / 1e6 << " s";
+  return s.str();
+}
+
+struct Row {
+  std::string what, ours, peer, ratio, target, verdict;
+};
+std::vector<Row> rows;
+Json out_rows = Json::array();
+
+void add(const std::string& what, std::optional<double> ours_us, const std::string& peer_label,
+         std::optional<double> peer_us, std::optional<double> max_us,
+         std::optional<double> min_ratio) {
+  Row r{what, ours_us ? show(*ours_us) : "not run", "", "", "", ""};
+  Json j{{"case", what}, {"ours_us", ours_us ? Json(*ours_us) : Json(nullptr)}};
+  std::vector<std::string> missed;
+  if (peer_us && ours_us) {
+    const double ratio = *peer_us / *ours_us;
+    r.peer = peer_label + " " + show(*peer_us);
+    std::ostringstream s;
+    s << std::setprecision(3) << ratio << "x";
+    r.ratio = s.str();
+    j["peer"] = peer_label;
+    j["peer_us"] = *peer_us;
+    j["ratio"] = ratio;
+    if (min_ratio && ratio < *min_ratio) missed.push_back("ratio");
+  }
+  std::string target;
+  if (max_us) {
+    target = "<= " + show(*max_us);
+    j["target_max_us"] = *max_us;
+    if (!ours_us || *ours_us > *max_us) missed.push_back("time");
+  }
+  if (min_ratio) {
+    std::ostringstream s;
+    s << (target.empty() ? "" : ", ") << ">= " << *min_ratio << "x peer";
+    target += s.str();
+    j["target_min_ratio"] = *min_ratio;
+  }
+  r.target = target;
+  if (!max_us && !min_ratio)
+    r.verdict = "";
+  else
+    r.verdict = missed.empty() ? "met" : "MISSED";
+  j["met"] = (max_us || min_ratio) ? Json(missed.empty()) : Json(nullptr);
+  rows.push_back(r);
+  out_rows.push_back(j);
+}
+
+void add_counter(const std::string& what, const std::string& bench, const std::string& counter,
+                 double min_value, const std::string& unit) {
+  Row r{what, "not run", "", "", ">= " + std::to_string(static_cast<int>(min_value)) + unit, ""};
+  Json j{{"case", what}};
+  auto it = results.find(bench);
+  if (it != results.end() && it->second.raw.contains(counter)) {
+    const double v = it->second.raw[counter].get<double>();
+    std::ostringstream s;
+    s << std::setprecision(3) << v << unit;
+    r.ours = s.str();
+    r.verdict = v >= min_value ? "met" : "MISSED";
+    j["ours"] = v;
+    j["unit"] = unit;
+    j["target_min"] = min_value;
+    j["met"] = v >= min_value;
+  } else {
+    r.verdict = "MISSED";
+    j["met"] = false;
+  }
+  rows.push_back(r);
+  out_rows.push_back(j);
+}
+
+// How a cost grows with the building: the exponent of n between 100 and 1,000 nodes.
+Json growth = Json::object();
+void grows(const std::string& what, const std::string& bench) {
+  const auto a = us(bench + "/100"), b = us(bench + "/1000");
+  if (!a || !b || *a <= 0) return;
+  const double e = std::log(*b / *a) / std::log(10.0);
+  growth[what] = e;
+  std::ostringstream s;
+  s << std::setprecision(2) << "grows as n^" << e << " (100 to 1,000 nodes)";
+  rows.push_back({"  " + what, s.str(), "", "", "", ""});
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 3) {
+    std::cerr << "usage: bench_summary OUT.json BENCH.json...\n";
+    return 2;
+  }
+  try {
+    for (int k = 2; k < argc; ++k) read(argv[k]);
+  } catch (const std::exception& e) {
+    std::cerr << "bench_summary: " << e.what() << "\n";
+    return 2;
+  }
+  for (const char* px : {"352", "640"}) {
+    const std::string p = px, size = p == "352" ? "352x288" : "640x480";
+    const auto ours = us("BM_LampDetectAndTrack/" + p);
+    const std::optional<double> limit = p == "352" ? std::optional<double>(200.0) : std::nullopt;
+    add("ceiling detection + tracking, " + size, ours, "SimpleBlobDetector (1 threshold)",
+        us("BM_OpenCvSimpleBlobDetector/" + p), limit, 10.0);
+    add("ceiling detection + tracking, " + size, ours, "SimpleBlobDetector (default sweep)",
+        us("BM_OpenCvSimpleBlobDetectorSweep/" + p), std::nullopt, 10.0);
+    add("ceiling detection + tracking, " + size, ours, "vpDot2::searchDotsInArea",
+        us("BM_VispSearchDotsInArea/" + p), std::nullopt, std::nullopt);
+  }
+  add("omni detection, 1024x1024", us("BM_OmniDetector"), "paper's pipeline on OpenCV",
+      us("BM_PaperOmniPipelineOpenCv"), 2000.0, std::nullopt);
+  add("EKF predict", us("BM_EkfPredict"), "", std::nullopt, 0.1, std::nullopt);
+  const auto pu = us("BM_EkfPredictAndGatedUpdate"), pr = us("BM_EkfPredict");
+  add("EKF gated update (predict + update minus predict)",
+      pu && pr ? std::optional<double>(*pu - *pr) : std::nullopt, "", std::nullopt, 0.5,
+      std::nullopt);
+  add("EKF measurement 1 s late at 100 Hz", us("BM_EkfLateUpdateOneSecond"), "", std::nullopt, 20.0,
+      std::nullopt);
+  add("global localization, paper (2502 merits), museum", us("BM_GlobalLocalizationPaper"), "",
+      std::nullopt, 2000.0, std::nullopt);
+  add("global localization, default, museum", us("BM_GlobalLocalizationDefault"), "paper",
+      us("BM_GlobalLocalizationPaper"), 5000.0, std::nullopt);
+  for (const char* n : {"10", "100", "1000"})
+    add(std::string("global localization, default, ") + n + "-node building",
+        us(std::string("BM_GlobalLocalizationBuilding/") + n), "", std::nullopt,
+        std::string(n) == "1000" ? std::optional<double>(50000.0) : std::nullopt, std::nullopt);
+  grows("global localization", "BM_GlobalLocalizationBuilding");
+  for (const char* n : {"10", "100", "1000"})
+    add(std::string("map load and validation, ") + n + "-node building",
+        us(std::string("BM_BuildingMapLoad/") + n), "", std::nullopt,
+        std::string(n) == "1000" ? std::optional<double>(200000.0) : std::nullopt, std::nullopt);
+  grows("map load", "BM_BuildingMapLoad");
+  for (const char* n : {"10", "100", "1000"})
+    add(std::string("route planning, corner to corner, ") + n + "-node building",
+        us(std::string("BM_BuildingRoutePlanning/") + n), "", std::nullopt,
+        std::string(n) == "1000" ? std::optional<double>(1000.0) : std::nullopt, std::nullopt);
+  grows("route planning", "BM_BuildingRoutePlanning");
+  for (const char* n : {"10", "100", "1000"})
+    add(std::string("which node holds a point, ") + n + "-node building",
+        us(std::string("BM_BuildingWhichNode/") + n), "", std::nullopt, std::nullopt, std::nullopt);
+  grows("which-node query", "BM_BuildingWhichNode");
+  add_counter("replay of the office mission (140 s)", "BM_ReplayOfficeMission", "realtime_factor",
+              50, "x real time");
+  for (const char* n : {"10", "100", "1000"})
+    add_counter(std::string("replay of a 10-minute mission, ") + n + "-node building",
+                std::string("BM_ReplayBuildingMission/") + n, "realtime_factor", 50, "x real time");
+  grows("replay", "BM_ReplayBuildingMission");
+
+  std::size_t w[5] = {4, 4, 4, 5, 6};
+  for (const auto& r : rows) {
+    w[0] = std::max(w[0], r.what.size());
+    w[1] = std::max(w[1], r.ours.size());
+    w[2] = std::max(w[2], r.peer.size());
+    w[3] = std::max(w[3], r.ratio.size());
+    w[4] = std::max(w[4], r.target.size());
+  }
+  auto line = [&](const Row& r) {
+    std::cout << std::left << std::setw(w[0] + 2) << r.what << std::setw(w[1] + 2) << r.ours
+              << std::setw(w[2] + 2) << r.peer << std::setw(w[3] + 2) << r.ratio
+              << std::setw(w[4] + 2) << r.target << r.verdict << "\n";
+  };
+  line({"case", "ours", "peer", "ratio", "target", ""});
+  for (const auto& r : rows) line(r);
+  int missed = 0;
+  for (const auto& r : rows) missed += r.verdict == "MISSED";
+  std::cout << "\n" << missed << " target(s) missed\n";
+  Json out{{"machine",
+            {{"host", context.value("host_name", "")},
+             {"cpus", context.value("num_cpus", 0)},
+             {"mhz_per_cpu", context.value("mhz_per_cpu", 0)},
+             {"date", context.value("date", "")},
+             {"build", context.value("library_build_type", "")}}},
+           {"rows", out_rows},
+           {"growth_exponent_100_to_1000_nodes", growth},
+           {"targets_missed", missed}};
+  std::ofstream(argv[1]) << out.dump(2) << "\n";
+  return 0;
+}
