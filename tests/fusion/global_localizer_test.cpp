@@ -219,7 +219,7 @@ TEST(GlobalLocalizer, SymmetricCeilingGivesSeveralHypothesesAndSaysSo) {
   EXPECT_NEAR(total, 1.0, 1e-9);
 }
 
-// A generated office building of 1,000 nodes and 8,180 lamps, 0.9 m above the omni camera: a
+// A generated office building of 1,000 nodes and 5,732 lamps, 0.9 m above the omni camera: a
 // regular grid of identical corridors, where one image cannot tell most places apart. Each view
 // must be found (the truth among the hypotheses) or reported ambiguous, and then the truth must
 // be as plausible as the hypotheses returned: the ambiguity is the building's, not a search
