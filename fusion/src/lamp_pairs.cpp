@@ -108,6 +108,7 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
   // The graph: a robot stands in a node's region.
   std::vector<std::pair<double, Pose2>> scored;
   int outside = 0;
+  int last_votes = 0;
   for (const auto& [votes, pose] : voted) {
     if (int(scored.size()) >= q.candidates) break;
     if (q.restrict_to_graph && has_regions && !node_of(pose)) {
@@ -116,7 +117,16 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
     }
     scored.emplace_back(evaluate(pose, {}, 0.3, 3 * kDeg, q.tilt_sigma_deg * kDeg, blobs).cost,
                         pose);
+    last_votes = votes;
   }
+  // On a regular ceiling many places get the most votes alike (the lamps near the axis repeat);
+  // when more of them tie for the top than could be scored, the search did not see them all, and
+  // says so.
+  std::size_t tied = 0;
+  const int top_votes = voted.empty() ? 0 : voted.front().first;
+  for (const auto& rv : ranked) tied += rv.first == top_votes ? 1 : 0;
+  const bool truncated = !scored.empty() && last_votes == top_votes &&
+                         tied > scored.size() + static_cast<std::size_t>(outside);
   out.merit_evaluations = static_cast<int>(scored.size());
   if (scored.empty()) {
     out.why = voted.empty() ? "no pair of map lamps is spaced like any pair of the " +
@@ -134,6 +144,12 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
     refined.push_back(std::move(h));
   }
   finish(out, refined, d);
+  if (truncated && out.found()) {
+    out.ambiguous = true;
+    out.why = std::to_string(tied) + " places look alike to the lamps near the optical axis (a " +
+              "regular ceiling); the " + std::to_string(scored.size()) +
+              " scored are not all of them: more images are needed to choose";
+  }
   return out;
 }
 

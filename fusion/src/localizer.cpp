@@ -62,6 +62,7 @@ struct Localizer::Impl {
     Pose2 odometry;             // dead-reckoned pose at its frame's capture
   };
   std::vector<Candidate> candidates;
+  bool unconfirmed = false;  // the candidates come from an ambiguous image, not yet carried
   RelocalizationStatus relocalization;
   LocalizerMode mode = LocalizerMode::tracking;
   std::optional<std::pair<double, double>> last_wheels;
@@ -164,6 +165,11 @@ struct Localizer::Impl {
       // The paper's method names one pose (its argmin); the default one names all that remain.
       const std::size_t n = r.method == GlobalMethod::paper ? 1 : r.hypotheses.size();
       for (std::size_t k = 0; k < n; ++k) candidates.push_back({r.hypotheses[k], odo});
+      // An ambiguous image (a regular ceiling whose look-alikes were not all scored) fixes
+      // nothing on its own, whatever is left: the next frame must agree.
+      unconfirmed = r.ambiguous;
+    } else {
+      unconfirmed = false;
     }
     std::stable_sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
       return a.hypothesis.score < b.hypothesis.score;
@@ -174,11 +180,15 @@ struct Localizer::Impl {
                      candidates.end());
     relocalization.candidates.clear();
     for (const Candidate& c : candidates) relocalization.candidates.push_back(c.hypothesis);
-    if (candidates.size() > 1) {
+    if (candidates.size() > 1 || unconfirmed) {
       ++counts.ambiguous_frames;
-      relocalization.why = std::to_string(candidates.size()) +
-                           " poses explain the omni view (a symmetric ceiling): waiting for the "
-                           "next frame to choose";
+      relocalization.why =
+          candidates.size() > 1
+              ? std::to_string(candidates.size()) +
+                    " poses explain the omni view (a symmetric ceiling): waiting for the next "
+                    "frame to choose"
+              : "the omni view is ambiguous (a regular ceiling): waiting for the next frame to "
+                "confirm";
       return;
     }
     const PoseHypothesis& h = candidates.front().hypothesis;

@@ -251,7 +251,10 @@ TEST(GlobalLocalizer, GeneratedBuildingFindsOrSaysAmbiguous) {
     }
     found += here;
     ambiguous += r.ambiguous;
-    EXPECT_TRUE(here || r.ambiguous) << "view " << views;
+    EXPECT_TRUE(here || r.ambiguous)
+        << "view " << views << ": truth " << truth << ", best " << r.hypotheses.front().pose
+        << " score " << r.hypotheses.front().score << ", " << r.hypotheses.size()
+        << " hypotheses, blobs " << r.blobs;
     if (!here) {
       const auto at_truth = global.refine(truth, 0.05, 0.02, d);
       ASSERT_TRUE(at_truth);
