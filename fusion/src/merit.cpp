@@ -101,8 +101,10 @@ MeritFunction::MeritFunction(std::vector<Vector2d> detected, double threshold, i
   cols_ = std::max(1, static_cast<int>(std::ceil((width + 1) / kCell)));
   rows_ = std::max(1, static_cast<int>(std::ceil((height + 1) / kCell)));
   // Each detection is listed in every cell with a point closer to it than the threshold.
-  std::vector<std::vector<int>> lists(static_cast<std::size_t>(cols_) * rows_);
-  for (std::size_t j = 0; j < detected_.size(); ++j) {
+  // Compressed rows, in two passes over the cells each detection covers (no list per cell: this
+  // runs for every image and every refined hypothesis).
+  const double t2 = threshold * threshold;
+  auto covered = [&](std::size_t j, auto&& visit) {
     const Vector2d q = detected_[j] + Vector2d(0.5, 0.5);  // cell coordinates start at -0.5 px
     const int x0 = std::max(0, static_cast<int>(std::floor((q.x() - threshold) / kCell)));
     const int x1 = std::min(cols_ - 1, static_cast<int>(std::floor((q.x() + threshold) / kCell)));
@@ -113,15 +115,17 @@ MeritFunction::MeritFunction(std::vector<Vector2d> detected, double threshold, i
         // Distance from the detection to the cell's rectangle.
         const double dx = std::max({0.0, x * kCell - q.x(), q.x() - (x + 1) * kCell});
         const double dy = std::max({0.0, y * kCell - q.y(), q.y() - (y + 1) * kCell});
-        if (dx * dx + dy * dy < threshold * threshold)
-          lists[static_cast<std::size_t>(y) * cols_ + x].push_back(static_cast<int>(j));
+        if (dx * dx + dy * dy < t2) visit(y * cols_ + x);
       }
-  }
-  cell_start_.assign(lists.size() + 1, 0);
-  for (std::size_t k = 0; k < lists.size(); ++k)
-    cell_start_[k + 1] = cell_start_[k] + static_cast<int>(lists[k].size());
-  cell_items_.reserve(cell_start_.back());
-  for (const auto& l : lists) cell_items_.insert(cell_items_.end(), l.begin(), l.end());
+  };
+  cell_start_.assign(static_cast<std::size_t>(cols_) * rows_ + 1, 0);
+  for (std::size_t j = 0; j < detected_.size(); ++j)
+    covered(j, [&](int cell) { ++cell_start_[cell + 1]; });
+  for (std::size_t k = 1; k < cell_start_.size(); ++k) cell_start_[k] += cell_start_[k - 1];
+  cell_items_.resize(cell_start_.back());
+  std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
+  for (std::size_t j = 0; j < detected_.size(); ++j)
+    covered(j, [&](int cell) { cell_items_[fill[cell]++] = static_cast<int>(j); });
   claim_d2_.resize(detected_.size());
   claim_by_.resize(detected_.size());
 }

@@ -11,6 +11,7 @@
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/ekf.hpp"
+#include "text_file.hpp"
 
 namespace lampnav::navigation {
 
@@ -328,19 +329,6 @@ std::string metrics_json(const Metrics& m) {
   return j.dump(2) + "\n";
 }
 
-namespace {
-
-void write_text(const std::string& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw InputError({path, "", ""}, "cannot write the file");
-  out << text;
-  if (!out) throw InputError({path, "", ""}, "write failed");
-}
-
-const char* mode_name(fusion::LocalizerMode m) { return fusion::to_string(m); }
-
-}  // namespace
-
 void write_replay(const ReplayResult& r, const io::MissionLog& log,
                   const graph::TopologicalMap& map, const std::string& map_geojson,
                   const std::string& robot_json, const std::string& dir) {
@@ -365,7 +353,7 @@ void write_replay(const ReplayResult& r, const io::MissionLog& log,
       p.pose = e.pose;
       for (int k = 0; k < 9; ++k) p.covariance[k] = e.covariance(k / 3, k % 3);
       p.node = e.node;
-      p.mode = mode_name(e.mode);
+      p.mode = fusion::to_string(e.mode);
       w.write(e.stamp, p);
     }
     for (const auto& f : r.lamp_frames) w.write(f.arrival, f.observations);
@@ -373,14 +361,14 @@ void write_replay(const ReplayResult& r, const io::MissionLog& log,
   }
   std::vector<std::pair<Stamp, Pose2>> est;
   for (const auto& e : r.estimates) est.emplace_back(e.stamp, e.pose);
-  write_text(dir + "/estimate.tum", tum(est));
+  write_text_file(dir + "/estimate.tum", tum(est));
   if (!log.truth.empty()) {
     const io::TruthTrack truth(log.truth);
     std::vector<std::pair<Stamp, Pose2>> t;
     for (const auto& s : truth.samples()) t.emplace_back(s.value.stamp, s.value.pose);
-    write_text(dir + "/truth.tum", tum(t));
+    write_text_file(dir + "/truth.tum", tum(t));
   }
-  write_text(dir + "/metrics.json", metrics_json(r.metrics));
+  write_text_file(dir + "/metrics.json", metrics_json(r.metrics));
 }
 
 }  // namespace lampnav::navigation

@@ -9,6 +9,7 @@
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/ekf.hpp"
+#include "text_file.hpp"
 
 namespace lampnav::navigation {
 
@@ -409,14 +410,9 @@ std::string report_html(const ReplayResult& r, const io::MissionLog& log,
 void write_report(const ReplayResult& r, const io::MissionLog& log,
                   const graph::TopologicalMap& map, const std::string& title,
                   const std::string& dir) {
-  auto write = [](const std::string& path, const std::string& text) {
-    std::ofstream out(path, std::ios::binary);
-    if (!out) throw InputError({path, "", ""}, "cannot write the file");
-    out << text;
-  };
   const std::vector<Figure> figures = report_figures(r, log, map);
-  write(dir + "/report.html", report_html(r, log, figures, title));
-  for (const auto& f : figures) write(dir + "/" + f.file, f.svg);
+  write_text_file(dir + "/report.html", report_html(r, log, figures, title));
+  for (const auto& f : figures) write_text_file(dir + "/" + f.file, f.svg);
 }
 
 }  // namespace lampnav::navigation
