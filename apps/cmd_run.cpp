@@ -50,16 +50,22 @@ void add_metric_rows(std::vector<std::pair<std::string, std::string>>& rows, con
     rows.push_back({"heading error", "mean " + fixed(m.yaw_error_deg.mean, 2) + " deg, RMS " +
                                          fixed(m.yaw_error_deg.rms, 2) + " deg, max " +
                                          fixed(m.yaw_error_deg.max, 2) + " deg"});
+  } else if (m.has_truth) {
+    rows.push_back({"errors", "not scored: no pose was ever published as tracking"});
   } else {
     rows.push_back({"errors", "not scored: the log has no truth"});
   }
+  if (m.has_truth)
+    rows.push_back({"wrong fixes", std::to_string(m.wrong_fixes) +
+                                       " (poses published as certain more than 0.5 m off)"});
   rows.push_back(
       {"kidnaps",
        std::to_string(m.kidnaps) + ", recovered " + std::to_string(m.recoveries) +
            (m.relocalization_latency_s.n
                 ? " (relocalized " + fixed(m.relocalization_latency_s.mean, 2) + " s after, mean)"
                 : "")});
-  rows.push_back({"time lost", fixed(m.lost_s, 1) + " s"});
+  rows.push_back({"time lost", fixed(m.lost_s, 1) + " s, ambiguous " + fixed(m.ambiguous_s, 1) +
+                                   " s (one of several places)"});
   rows.push_back({"frames", std::to_string(m.ceiling_frames) + " ceiling, " +
                                 std::to_string(m.omni_frames) + " omni; " +
                                 std::to_string(m.lamps_labelled) + " of " +

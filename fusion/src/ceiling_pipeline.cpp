@@ -7,6 +7,7 @@
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/chi_square.hpp"
+#include "lampnav/vision/camera_models.hpp"
 
 namespace lampnav::fusion {
 
@@ -237,6 +238,31 @@ CeilingObservation CeilingPipeline::process(Stamp stamp, const vision::ImageView
     out.no_measurement = PoseRefusal::no_usable_lamp;
   }
   return out;
+}
+
+int unseen_lamps(const graph::TopologicalMap& map, const vision::PinholeCamera& cam,
+                 const CeilingGeometry& geometry, const std::vector<vision::LampDetection>& lamps,
+                 const Pose2& pose, const Eigen::Matrix3d& P) {
+  const double sigma = std::sqrt(std::max(P(0, 0), P(1, 1)));
+  if (sigma > 0.3) return 0;
+  const double fx = cam.parameters().fx;
+  int missing = 0;
+  for (const graph::Lamp* l : map.lamps_within(pose.translation(), 4.0)) {
+    const auto n = geometry.predict(pose, l->xyz);
+    if (!n) continue;
+    const double h = std::max(0.5, l->xyz.z() - geometry.mount_origin().z());
+    // Margin: 3 sigma of position, 3 sigma of heading over a 2 m lever, and most of the lamp.
+    const double margin = fx * (3 * sigma + std::sqrt(P(2, 2)) * 3 * 2.0 + 0.6 * l->length) / h;
+    const Eigen::Vector2d px = cam.pixel_of_normalized(*n);
+    if (px.x() < margin || px.y() < margin || px.x() > cam.width() - 1 - margin ||
+        px.y() > cam.height() - 1 - margin)
+      continue;
+    bool seen = false;
+    for (const auto& d : lamps)
+      if ((d.centre_px - px).norm() < margin + 0.5 * fx * l->length / h) seen = true;
+    if (!seen) ++missing;
+  }
+  return missing;
 }
 
 }  // namespace lampnav::fusion

@@ -55,6 +55,8 @@ void GlobalLocalizerOptions::validate() const {
   check(q.distinct_m > 0 && q.distinct_deg > 0, "pairs.distinct_m", "must be positive");
   check(q.candidates >= 1 && q.refined >= 1 && q.refined <= q.candidates, "pairs.candidates",
         "must be positive, with refined <= candidates");
+  check(q.complete_vote_fraction > 0 && q.complete_vote_fraction <= 1, "pairs.complete_vote_fraction",
+        "must be in (0, 1]");
   check(max_hypotheses >= 1, "max_hypotheses", "must be positive");
 }
 
@@ -361,8 +363,8 @@ MeritFunction GlobalLocalizer::Impl::merit_function(const vision::OmniDetection&
 }
 
 void GlobalLocalizer::Impl::finish(GlobalLocalization& out, std::vector<PoseHypothesis> hs,
-                                   const vision::OmniDetection& d) const {
-  const LampPairOptions& q = o.pairs;
+                                   const vision::OmniDetection& d, const LampPairOptions& q,
+                                   int max_hypotheses) const {
   std::stable_sort(hs.begin(), hs.end(), [](const PoseHypothesis& a, const PoseHypothesis& b) {
     return a.score < b.score;
   });
@@ -373,7 +375,7 @@ void GlobalLocalizer::Impl::finish(GlobalLocalization& out, std::vector<PoseHypo
     for (const auto& k : kept)
       if (!distinct(h.pose, k.pose, q.distinct_m, q.distinct_deg)) dup = true;
     if (!dup) kept.push_back(std::move(h));
-    if (int(kept.size()) >= o.max_hypotheses) break;
+    if (int(kept.size()) >= max_hypotheses) break;
   }
   if (kept.empty()) {
     out.why = "no pose explains any of the " + std::to_string(out.blobs) + " lamps seen";
@@ -430,7 +432,36 @@ GlobalLocalization GlobalLocalizer::locate(const vision::OmniDetection& d,
     out.why = "no lamp in the image";
     return out;
   }
-  return method == GlobalMethod::paper ? impl_->paper(d) : impl_->lamp_pairs(d);
+  return method == GlobalMethod::paper ? impl_->paper(d)
+                                        : impl_->lamp_pairs(d, impl_->o.pairs, impl_->o.max_hypotheses);
+}
+
+GlobalLocalization GlobalLocalizer::enumerate(const vision::OmniDetection& d, int cap,
+                                              double vote_fraction) const {
+  const Impl& m = *impl_;
+  GlobalLocalization out;
+  if (d.flooded || m.lamps.empty() || d.blobs.empty()) return locate(d, GlobalMethod::lamp_pairs);
+  LampPairOptions q = m.o.pairs;
+  q.candidates = q.refined = std::max(1, cap);
+  q.complete_vote_fraction = std::clamp(vote_fraction, 1e-3, 1.0);
+  return m.lamp_pairs(d, q, std::max(1, cap));
+}
+
+GlobalLocalizer::PoseScore GlobalLocalizer::score(const Pose2& pose, double position_sigma,
+                                                  double yaw_sigma,
+                                                  const vision::OmniDetection& d) const {
+  const Impl& m = *impl_;
+  PoseScore s;
+  if (d.flooded) return s;
+  const std::vector<BlobRay> blobs = m.blob_rays(d, m.o.pairs.max_theta_deg * kDeg);
+  const Evaluation e = m.evaluate(pose, {}, std::max(1e-3, position_sigma),
+                                  std::max(1e-4, yaw_sigma), m.o.pairs.tilt_sigma_deg * kDeg, blobs);
+  s.cost = e.cost;
+  s.expected = e.expected;
+  s.missing = e.missing;
+  s.unexplained = e.unexplained;
+  s.matched = static_cast<int>(e.matches.size());
+  return s;
 }
 
 std::optional<PoseHypothesis> GlobalLocalizer::refine(const Pose2& predicted, double position_sigma,

@@ -162,11 +162,13 @@ struct GlobalLocalizer::Impl {
 
   // ---------------------------------------------------------------------------------------
   // Method `default`.
-  GlobalLocalization lamp_pairs(const vision::OmniDetection& d) const;
+  // With `q` and `max_hypotheses` (the options', or enumerate()'s larger caps).
+  GlobalLocalization lamp_pairs(const vision::OmniDetection& d, const LampPairOptions& q,
+                                int max_hypotheses) const;
 
   // Ranks, merges near-duplicates, weighs, places on the graph, and says whether it is ambiguous.
   void finish(GlobalLocalization& out, std::vector<PoseHypothesis> hs,
-              const vision::OmniDetection& d) const;
+              const vision::OmniDetection& d, const LampPairOptions& q, int max_hypotheses) const;
 
   // ---------------------------------------------------------------------------------------
   // Method `paper` (Alg. 3).

@@ -12,8 +12,9 @@ namespace lampnav::fusion {
 
 using namespace detail;
 
-GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection& d) const {
-  const LampPairOptions& q = o.pairs;
+GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection& d,
+                                                     const LampPairOptions& q,
+                                                     int max_hypotheses) const {
   GlobalLocalization out;
   out.method = GlobalMethod::lamp_pairs;
   const std::vector<BlobRay> blobs = blob_rays(d, q.max_theta_deg * kDeg);
@@ -107,26 +108,22 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
   }
   // The graph: a robot stands in a node's region.
   std::vector<std::pair<double, Pose2>> scored;
-  int outside = 0;
-  int last_votes = 0;
+  std::size_t handled = 0;  // voted cells scored or found outside the regions
   for (const auto& [votes, pose] : voted) {
     if (int(scored.size()) >= q.candidates) break;
-    if (q.restrict_to_graph && has_regions && !node_of(pose)) {
-      ++outside;
-      continue;
-    }
+    ++handled;
+    if (q.restrict_to_graph && has_regions && !node_of(pose)) continue;
     scored.emplace_back(evaluate(pose, {}, 0.3, 3 * kDeg, q.tilt_sigma_deg * kDeg, blobs).cost,
                         pose);
-    last_votes = votes;
   }
   // On a regular ceiling many places get the most votes alike (the lamps near the axis repeat);
-  // when more of them tie for the top than could be scored, the search did not see them all, and
-  // says so.
+  // when more of them than could be scored reach the top votes (or the given fraction of them),
+  // the search did not see them all, and says so.
   std::size_t tied = 0;
   const int top_votes = voted.empty() ? 0 : voted.front().first;
-  for (const auto& rv : ranked) tied += rv.first == top_votes ? 1 : 0;
-  const bool truncated = !scored.empty() && last_votes == top_votes &&
-                         tied > scored.size() + static_cast<std::size_t>(outside);
+  const int enough = std::max(1, int(std::ceil(q.complete_vote_fraction * top_votes - 1e-9)));
+  for (const auto& rv : ranked) tied += rv.first >= enough ? 1 : 0;
+  const bool truncated = !scored.empty() && tied > handled;
   out.merit_evaluations = static_cast<int>(scored.size());
   if (scored.empty()) {
     out.why = voted.empty() ? "no pair of map lamps is spaced like any pair of the " +
@@ -143,7 +140,8 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
     if (q.restrict_to_graph && has_regions && !node_of(h.pose)) continue;
     refined.push_back(std::move(h));
   }
-  finish(out, refined, d);
+  finish(out, refined, d, q, max_hypotheses);
+  out.complete = !truncated && out.plausible < max_hypotheses;
   if (truncated && out.found()) {
     out.ambiguous = true;
     out.why = std::to_string(tied) + " places look alike to the lamps near the optical axis (a " +

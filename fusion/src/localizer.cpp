@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/vision/camera_models.hpp"
@@ -17,6 +16,8 @@ const char* to_string(LocalizerMode m) {
       return "lost";
     case LocalizerMode::relocalized:
       return "relocalized";
+    case LocalizerMode::ambiguous:
+      return "ambiguous";
   }
   return "?";
 }
@@ -33,13 +34,11 @@ void LocalizerOptions::validate() const {
   global.validate();
   if (omni_update_min_lamps < 0)
     throw InputError({"", "localizer options", "omni_update_min_lamps"}, "must not be negative");
-  if (!(candidate_sigma_m > 0) || !(candidate_sigma_per_m >= 0) || !(candidate_sigma_yaw_deg > 0))
-    throw InputError({"", "localizer options", "candidate_sigma"}, "must be positive");
+  hypotheses.validate();
 }
 
 namespace {
 constexpr double kDeg = M_PI / 180.0;
-constexpr Duration kOdometryKept = std::chrono::seconds(120);
 }  // namespace
 
 struct Localizer::Impl {
@@ -54,17 +53,12 @@ struct Localizer::Impl {
   std::optional<OmniCheck> omni_check;
   std::optional<GlobalLocalizer> global;
   KidnapMonitor monitor;
-  // Dead reckoning in its own frame, kept whatever the filter's state: it carries relocalization
-  // candidates from one omni frame to the next, and a first fix to the latest odometry.
-  std::deque<std::pair<Stamp, Pose2>> odometry;
-  struct Candidate {
-    PoseHypothesis hypothesis;  // score: summed over the frames it was scored on
-    Pose2 odometry;             // dead-reckoned pose at its frame's capture
-  };
-  std::vector<Candidate> candidates;
-  bool unconfirmed = false;  // the candidates come from an ambiguous image, not yet carried
+  // Dead reckoning in its own frame, kept whatever the filter's state: it carries hypotheses
+  // between frames, and a first fix to the latest odometry.
+  OdometryTrack odometry;
+  std::optional<HypothesisSet> hypotheses;
   RelocalizationStatus relocalization;
-  LocalizerMode mode = LocalizerMode::tracking;
+  LocalizerMode mode = LocalizerMode::lost;  // until told, or found
   std::optional<std::pair<double, double>> last_wheels;
   CeilingObservation last_ceiling;
   vision::OmniDetection last_omni;
@@ -78,18 +72,21 @@ struct Localizer::Impl {
         o(fix_semi_axis(std::move(opt), robot)),
         ekf(o.ekf),
         calibration(o.calibration),
-        monitor(o.kidnap) {
+        monitor(o.kidnap),
+        odometry(robot.semi_axis) {
     o.validate();
-    if (const CameraDescription* c = robot.find_camera("ceiling_camera")) {
-      pipeline.emplace(m, *c, o.ceiling);
-      ceiling_model.emplace(*c);
-      ceiling_geometry.emplace(*c);
+    const CameraDescription* ceiling_camera = robot.find_camera("ceiling_camera");
+    if (ceiling_camera) {
+      pipeline.emplace(m, *ceiling_camera, o.ceiling);
+      ceiling_model.emplace(*ceiling_camera);
+      ceiling_geometry.emplace(*ceiling_camera);
     }
     if (const CameraDescription* c = robot.find_camera("omni_camera")) {
       omni_detector.emplace(*c, o.omni_detector);
       omni_check.emplace(m, *c, o.omni_check);
       global.emplace(m, *c, o.global);
     }
+    hypotheses.emplace(m, ceiling_camera, global ? &*global : nullptr, o.ceiling, o.hypotheses);
   }
 
   static LocalizerOptions fix_semi_axis(LocalizerOptions opt, const RobotDescription& robot) {
@@ -98,105 +95,64 @@ struct Localizer::Impl {
     return opt;
   }
 
-  Stamp now() const { return ekf.initialized() ? ekf.stamp() : Stamp{}; }
+  Stamp now() const {
+    if (ekf.initialized()) return ekf.stamp();
+    return odometry.empty() ? Stamp{} : odometry.last_stamp();
+  }
+  bool unsure() const { return mode == LocalizerMode::lost || mode == LocalizerMode::ambiguous; }
 
   void set_mode(LocalizerMode m, const std::string& why) {
     if (m == mode) return;
+    const bool was_unsure = unsure();
     mode = m;
     events.push_back({now(), m, why});
-    if (m == LocalizerMode::lost) {
-      candidates.clear();
+    if (unsure() && !was_unsure) {
       if (pipeline) pipeline->reset();  // its labels are worthless
       calibration.forget_measurements();
     }
   }
 
-  void track_odometry(Stamp stamp, double dl, double dr) {
-    if (!std::isfinite(dl) || !std::isfinite(dr)) return;
-    if (odometry.empty()) {
-      odometry.emplace_back(stamp, Pose2());
-      return;
+  // The hypotheses as the estimate publishes them, carried to `t`.
+  std::vector<WeightedPose> weighted(Stamp t) const {
+    std::vector<WeightedPose> out;
+    for (const Hypothesis& h : hypotheses->hypotheses()) {
+      const Hypothesis c = hypotheses->carried(h, t, odometry);
+      out.push_back({c.pose, c.covariance, h.weight, map->node_containing(c.pose.translation())});
     }
-    if (stamp <= odometry.back().first) return;
-    const StateVector x = predict_motion(odometry.back().second.vector(), dl, dr, o.ekf.semi_axis);
-    odometry.emplace_back(stamp, Pose2(x.x(), x.y(), wrap_angle(x.z())));
-    while (odometry.size() > 2 && stamp - odometry.front().first > kOdometryKept)
-      odometry.pop_front();
+    return out;
   }
 
-  // The dead-reckoned pose at `t`, interpolated; the nearest end outside the kept span.
-  Pose2 odometry_at(Stamp t) const {
-    if (odometry.empty()) return {};
-    auto it = std::lower_bound(odometry.begin(), odometry.end(), t,
-                               [](const auto& a, Stamp s) { return a.first < s; });
-    if (it == odometry.begin()) return it->second;
-    if (it == odometry.end()) return odometry.back().second;
-    const auto& [tb, b] = *it;
-    const auto& [ta, a] = *std::prev(it);
-    const double f = to_seconds(t - ta) / std::max(1e-12, to_seconds(tb - ta));
-    return Pose2(a.translation() + f * (b.translation() - a.translation()),
-                 wrap_angle(a.yaw() + f * wrap_angle(b.yaw() - a.yaw())));
-  }
-
-  // An omni frame while lost (or before any pose): global localization, or the candidates
-  // of earlier frames carried here by odometry and scored again.
-  void relocalize(Stamp stamp, Localizer& self) {
-    ++counts.relocalization_frames;
-    const Pose2 odo = odometry_at(stamp);
-    std::vector<Candidate> next;
-    for (const Candidate& c : candidates) {
-      const Pose2 delta = c.odometry.between(odo);
-      const double travel = delta.translation().norm() + o.ekf.semi_axis * std::abs(delta.yaw());
-      const double sp = o.candidate_sigma_m + o.candidate_sigma_per_m * travel;
-      const double sy = o.candidate_sigma_yaw_deg * kDeg + o.candidate_sigma_per_m * travel;
-      std::optional<PoseHypothesis> h =
-          global->refine(c.hypothesis.pose * delta, sp, sy, last_omni);
-      if (!h) continue;
-      h->score += c.hypothesis.score;
-      next.push_back({std::move(*h), odo});
-    }
-    candidates = std::move(next);
-    if (candidates.empty()) {
-      const GlobalLocalization r = global->locate(last_omni);
-      if (!r.found()) {
-        relocalization = {{}, r.why};
+  // After a frame weighed the hypotheses: a fix when one holds the evidence, else the mode says
+  // whether the places the robot may be are all known (ambiguous) or not (lost).
+  void settle(Stamp stamp, Localizer& self) {
+    relocalization.verdict = hypotheses->verdict();
+    relocalization.why = hypotheses->why();
+    relocalization.hypotheses.clear();
+    for (const Hypothesis& h : hypotheses->hypotheses())
+      relocalization.hypotheses.push_back({h.pose, h.covariance, h.weight, h.node});
+    if (const Hypothesis* w = hypotheses->winner()) {
+      // Carried to the newest odometry, so the fix is inside the filter's history.
+      const Stamp at = odometry.empty() ? stamp : std::max(stamp, odometry.last_stamp());
+      const Hypothesis c = hypotheses->carried(*w, at, odometry);
+      relocalization.why.clear();
+      if (self.global_fix({at, c.pose, c.covariance, "omni"})) {
+        hypotheses->clear();
         return;
       }
-      // The paper's method names one pose (its argmin); the default one names all that remain.
-      const std::size_t n = r.method == GlobalMethod::paper ? 1 : r.hypotheses.size();
-      for (std::size_t k = 0; k < n; ++k) candidates.push_back({r.hypotheses[k], odo});
-      // An ambiguous image (a regular ceiling whose look-alikes were not all scored) fixes
-      // nothing on its own, whatever is left: the next frame must agree.
-      unconfirmed = r.ambiguous;
-    } else {
-      unconfirmed = false;
     }
-    std::stable_sort(candidates.begin(), candidates.end(), [](const auto& a, const auto& b) {
-      return a.hypothesis.score < b.hypothesis.score;
-    });
-    const double limit = candidates.front().hypothesis.score + o.global.pairs.ambiguity_margin;
-    candidates.erase(std::remove_if(candidates.begin(), candidates.end(),
-                                    [&](const Candidate& c) { return c.hypothesis.score > limit; }),
-                     candidates.end());
-    relocalization.candidates.clear();
-    for (const Candidate& c : candidates) relocalization.candidates.push_back(c.hypothesis);
-    if (candidates.size() > 1 || unconfirmed) {
+    if (relocalization.verdict == HypothesisVerdict::ambiguous) {
       ++counts.ambiguous_frames;
-      relocalization.why =
-          candidates.size() > 1
-              ? std::to_string(candidates.size()) +
-                    " poses explain the omni view (a symmetric ceiling): waiting for the next "
-                    "frame to choose"
-              : "the omni view is ambiguous (a regular ceiling): waiting for the next frame to "
-                "confirm";
-      return;
+      set_mode(LocalizerMode::ambiguous, relocalization.why);
+    } else {
+      set_mode(LocalizerMode::lost, relocalization.why);
     }
-    const PoseHypothesis& h = candidates.front().hypothesis;
-    Eigen::Matrix3d P = h.covariance;
-    P.diagonal() += Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, std::pow(0.5 * kDeg, 2));
-    candidates.clear();
-    relocalization.why.clear();
-    self.global_fix({stamp, h.pose, P, "omni"});
+  }
+
+  // An omni frame while unsure: the hypotheses weighed (and born, while they are not all known).
+  void relocalize(Stamp stamp, Localizer& self) {
+    ++counts.relocalization_frames;
+    hypotheses->omni(stamp, last_omni, odometry);
+    settle(stamp, self);
   }
 
   // While tracking: the omni frame's lamps, matched near the estimate, as a pose measurement.
@@ -215,35 +171,11 @@ struct Localizer::Impl {
   }
 
   void lose(const std::optional<std::string>& why) {
-    if (why && mode != LocalizerMode::lost) set_mode(LocalizerMode::lost, *why);
-  }
-
-  // Map lamps the prior puts so well inside the image that, even 3 sigma off, they would be in
-  // full view; and whether anything was seen near each.
-  int expected_missing(const CeilingObservation& ob, const FilterState& prior) const {
-    const double sigma = std::sqrt(std::max(prior.P(0, 0), prior.P(1, 1)));
-    if (sigma > 0.3) return 0;
-    const vision::PinholeCamera& cam = *ceiling_model;
-    const double fx = cam.parameters().fx;
-    int missing = 0;
-    const Pose2 pose = prior.pose();
-    for (const graph::Lamp* l : map->lamps_within(pose.translation(), 4.0)) {
-      const auto n = ceiling_geometry->predict(pose, l->xyz);
-      if (!n) continue;
-      const double h = std::max(0.5, l->xyz.z() - ceiling_geometry->mount_origin().z());
-      // Margin: 3 sigma of position, 3 sigma of heading over a 2 m lever, and most of the lamp.
-      const double margin =
-          fx * (3 * sigma + std::sqrt(prior.P(2, 2)) * 3 * 2.0 + 0.6 * l->length) / h;
-      const Eigen::Vector2d px = cam.pixel_of_normalized(*n);
-      if (px.x() < margin || px.y() < margin || px.x() > cam.width() - 1 - margin ||
-          px.y() > cam.height() - 1 - margin)
-        continue;
-      bool seen = false;
-      for (const auto& d : ob.lamps)
-        if ((d.detection.centre_px - px).norm() < margin + 0.5 * fx * l->length / h) seen = true;
-      if (!seen) ++missing;
-    }
-    return missing;
+    if (!why || unsure()) return;
+    // The estimate tracked until now stays one of the places the robot may be: a false alarm
+    // then costs a few frames, never the pose.
+    if (ekf.initialized()) hypotheses->keep(ekf.stamp(), ekf.pose(), ekf.covariance(), odometry);
+    set_mode(LocalizerMode::lost, *why);
   }
 
   void observe(const CeilingObservation& ob, const FilterState& prior) {
@@ -256,9 +188,14 @@ struct Localizer::Impl {
       if (l.lamp) ++e.labelled;
       if (!l.lamp && l.outcome == LabelOutcome::no_candidate) ++e.unexplained;
     }
-    if (ceiling_model) e.expected_missing = expected_missing(ob, prior);
+    if (ceiling_model) {
+      std::vector<vision::LampDetection> seen;
+      for (const auto& l : ob.lamps) seen.push_back(l.detection);
+      e.expected_missing =
+          unseen_lamps(*map, *ceiling_model, *ceiling_geometry, seen, prior.pose(), prior.P);
+    }
     e.inconsistent = ob.no_measurement == PoseRefusal::labels_disagree;
-    if (mode == LocalizerMode::lost) {
+    if (unsure()) {
       ++counts.frames_while_lost;
       return;
     }
@@ -278,7 +215,7 @@ struct Localizer::Impl {
       }
       if (r.refusal == Refusal::gated) e.measurement_refused = true;
       if (r.applied() || r.refusal == Refusal::gated) lose(monitor.innovation(r.mahalanobis2));
-      if (mode == LocalizerMode::lost) return;
+      if (unsure()) return;
     }
     lose(monitor.ceiling(e));
   }
@@ -313,7 +250,7 @@ std::optional<Refusal> Localizer::wheels(Stamp stamp, double left, double right)
     // Before the first pose the readings still count: relocalization dead-reckons with them.
     m.last_wheels = {left, right};
     if (!r) m.calibration.wheels(stamp, dl, dr);
-    m.track_odometry(stamp, cl, cr);
+    m.odometry.add(stamp, cl, cr);
   } else if (*r == Refusal::wheel_jump) {
     // An encoder glitch or reset: the jump is not motion; measure from the new reading on.
     m.last_wheels = {left, right};
@@ -336,6 +273,30 @@ const CeilingObservation& Localizer::ceiling_frame(Stamp stamp, const vision::Im
   if (!m.pipeline)
     throw InputError({"", "robot.json", "cameras"}, "the robot has no ceiling_camera");
   const std::optional<FilterState> prior = prior_at(stamp);
+  if (m.unsure()) {
+    // Detected and tracked as usual (labelled from the likeliest place, which no one uses); the
+    // lamps weigh every hypothesis.
+    Pose2 pose;
+    Eigen::Matrix3d P = Eigen::Vector3d(100, 100, 10).asDiagonal();
+    const auto& hs = m.hypotheses->hypotheses();
+    if (!hs.empty()) {
+      const Hypothesis c = m.hypotheses->carried(hs.front(), stamp, m.odometry);
+      pose = c.pose;
+      P = c.covariance;
+    } else if (prior) {
+      pose = prior->pose();
+      P = prior->P;
+    }
+    m.last_ceiling = m.pipeline->process(stamp, image, pose, P);
+    ++m.counts.ceiling_frames;
+    ++m.counts.frames_while_lost;
+    if (hs.empty()) return m.last_ceiling;
+    std::vector<vision::LampDetection> lamps;
+    for (const auto& l : m.last_ceiling.lamps) lamps.push_back(l.detection);
+    m.hypotheses->ceiling(stamp, lamps, m.odometry);
+    m.settle(stamp, *this);
+    return m.last_ceiling;
+  }
   if (!prior) {
     ++m.counts.frames_too_old;
     m.last_ceiling.no_measurement_reason = "captured before the filter's history";
@@ -347,6 +308,10 @@ const CeilingObservation& Localizer::ceiling_frame(Stamp stamp, const vision::Im
 }
 
 void Localizer::ceiling_observation(const CeilingObservation& ob) {
+  if (impl_->unsure()) {
+    ++impl_->counts.frames_while_lost;  // labelled from a pose that is not known
+    return;
+  }
   const std::optional<FilterState> prior = prior_at(ob.stamp);
   if (!prior) {
     ++impl_->counts.frames_too_old;
@@ -359,28 +324,34 @@ const vision::OmniDetection& Localizer::omni_frame(Stamp stamp, const vision::Im
   Impl& m = *impl_;
   if (!m.omni_detector)
     throw InputError({"", "robot.json", "cameras"}, "the robot has no omni_camera");
-  m.last_omni = m.omni_detector->detect(image);
+  omni_detection(stamp, m.omni_detector->detect(image));
+  return m.last_omni;
+}
+
+void Localizer::omni_detection(Stamp stamp, const vision::OmniDetection& detection) {
+  Impl& m = *impl_;
+  if (!m.global) throw InputError({"", "robot.json", "cameras"}, "the robot has no omni_camera");
+  m.last_omni = detection;
   m.last_omni_stamp = stamp;
   ++m.counts.omni_frames;
-  if (m.mode == LocalizerMode::lost || !m.ekf.initialized()) {
+  if (m.unsure() || !m.ekf.initialized()) {
     m.relocalize(stamp, *this);
-    return m.last_omni;
+    return;
   }
-  if (m.last_omni_check && stamp - *m.last_omni_check < m.o.omni_check_period) return m.last_omni;
+  if (m.last_omni_check && stamp - *m.last_omni_check < m.o.omni_check_period) return;
   const std::optional<FilterState> prior = prior_at(stamp);
-  if (!prior) return m.last_omni;
+  if (!prior) return;
   m.last_omni_check = stamp;
   const OmniCheckResult r = m.omni_check->check(prior->pose(), prior->P, m.last_omni.blobs);
   if (m.mode == LocalizerMode::relocalized && r.conclusive && r.consistent)
     m.set_mode(LocalizerMode::tracking,
                "the omnidirectional view agrees with the relocalized pose");
   m.lose(m.monitor.omni(r));
-  if (m.mode == LocalizerMode::lost) {
+  if (m.unsure()) {
     m.relocalize(stamp, *this);  // the frame that showed the loss shows where the robot is
   } else if (r.conclusive && r.consistent && m.o.omni_update_min_lamps > 0) {
     m.omni_update(stamp, *prior);
   }
-  return m.last_omni;
 }
 
 bool Localizer::global_fix(const GlobalFix& fix) {
@@ -391,9 +362,9 @@ bool Localizer::global_fix(const GlobalFix& fix) {
       // The odometry read since the fix's capture moves it to the latest reading.
       Stamp at = fix.stamp;
       Pose2 pose = fix.pose;
-      if (!m.odometry.empty() && m.odometry.back().first > fix.stamp) {
-        at = m.odometry.back().first;
-        pose = fix.pose * m.odometry_at(fix.stamp).between(m.odometry.back().second);
+      if (!m.odometry.empty() && m.odometry.last_stamp() > fix.stamp) {
+        at = m.odometry.last_stamp();
+        pose = fix.pose * m.odometry.at(fix.stamp).between(m.odometry.last());
       }
       m.ekf.initialize(at, pose, fix.covariance);
     } catch (const InputError&) {
@@ -407,6 +378,7 @@ bool Localizer::global_fix(const GlobalFix& fix) {
   m.monitor.reset();
   if (m.pipeline) m.pipeline->reset();
   m.calibration.forget_measurements();
+  m.hypotheses->clear();
   m.set_mode(LocalizerMode::relocalized,
              "global fix" + (fix.source.empty() ? std::string() : " from " + fix.source));
   return true;
@@ -416,10 +388,18 @@ LocalizerEstimate Localizer::estimate() const {
   const Impl& m = *impl_;
   LocalizerEstimate e;
   e.mode = m.mode;
-  if (!m.ekf.initialized()) return e;
-  e.stamp = m.ekf.stamp();
-  e.pose = m.ekf.pose();
-  e.covariance = m.ekf.covariance();
+  e.stamp = m.now();
+  if (m.ekf.initialized()) {
+    e.pose = m.ekf.pose();
+    e.covariance = m.ekf.covariance();
+  }
+  if (m.unsure()) {
+    e.hypotheses = m.weighted(e.stamp);
+    if (!e.hypotheses.empty()) {
+      e.pose = e.hypotheses.front().pose;
+      e.covariance = e.hypotheses.front().covariance;
+    }
+  }
   e.node = m.map->node_containing(e.pose.translation());
   return e;
 }
@@ -430,6 +410,7 @@ const vision::OmniDetection* Localizer::last_omni() const {
 }
 Stamp Localizer::last_omni_stamp() const { return impl_->last_omni_stamp; }
 const RelocalizationStatus& Localizer::relocalization() const { return impl_->relocalization; }
+const HypothesisSet& Localizer::hypotheses() const { return *impl_->hypotheses; }
 const std::vector<LocalizerEvent>& Localizer::events() const { return impl_->events; }
 const LocalizerCounts& Localizer::counts() const { return impl_->counts; }
 const KidnapMonitor::Counts& Localizer::kidnap_counts() const { return impl_->monitor.counts(); }

@@ -161,7 +161,10 @@ std::vector<ChannelSpec> channel_specs() {
            R"(, "frame_id": {"type": "string"}, "pose": {"type": "object", "properties": {"position": {"type": "object"}, "orientation": {"type": "object"}}}}})"},
       {topics::kEstimate, "lampnav.PoseEstimate",
        R"({"type": "object", "properties": {)" + t +
-           R"(, "x": {"type": "number"}, "y": {"type": "number"}, "yaw": {"type": "number"}, "covariance": {"type": "array", "items": {"type": "number"}, "minItems": 9, "maxItems": 9}, "node": {"type": ["string", "null"]}, "mode": {"type": "string", "enum": ["tracking", "lost", "relocalized"]}}})"},
+           R"(, "x": {"type": "number"}, "y": {"type": "number"}, "yaw": {"type": "number"}, "covariance": {"type": "array", "items": {"type": "number"}, "minItems": 9, "maxItems": 9}, "node": {"type": ["string", "null"]}, "mode": {"type": "string", "enum": ["tracking", "lost", "relocalized", "ambiguous"]}}})"},
+      {topics::kHypotheses, "lampnav.Hypotheses",
+       R"({"type": "object", "properties": {)" + t +
+           R"(, "mode": {"type": "string", "enum": ["tracking", "lost", "relocalized", "ambiguous"]}, "hypotheses": {"type": "array", "items": {"type": "object", "properties": {"x": {"type": "number"}, "y": {"type": "number"}, "yaw": {"type": "number"}, "weight": {"type": "number"}, "node": {"type": "string"}}}}}})"},
       {topics::kLamps, "lampnav.LampObservations",
        R"({"type": "object", "properties": {)" + t +
            R"(, "camera": {"type": "string"}, "lamps": {"type": "array", "items": {"type": "object", "properties": {"u": {"type": "number"}, "v": {"type": "number"}, "orientation": {"type": "number"}, "area": {"type": "number"}, "track": {"type": "integer"}, "label": {"type": ["string", "null"]}}}}}})"},
@@ -267,6 +270,18 @@ void MissionLogWriter::write(Stamp available, const LampObservations& o) {
                      {"label", l.label ? Json(*l.label) : Json(nullptr)}});
   impl_->put(topics::kLamps, available, o.stamp,
              Json{{"timestamp", stamp_json(o.stamp)}, {"camera", o.camera}, {"lamps", lamps}});
+}
+
+void MissionLogWriter::write(Stamp available, const Hypotheses& h) {
+  Json list = Json::array();
+  for (const auto& e : h.hypotheses)
+    list.push_back({{"x", e.pose.x()},
+                    {"y", e.pose.y()},
+                    {"yaw", e.pose.yaw()},
+                    {"weight", e.weight},
+                    {"node", e.node}});
+  impl_->put(topics::kHypotheses, available, h.stamp,
+             Json{{"timestamp", stamp_json(h.stamp)}, {"mode", h.mode}, {"hypotheses", list}});
 }
 
 void MissionLogWriter::write(Stamp available, const SceneUpdate& u) {

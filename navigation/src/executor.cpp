@@ -131,11 +131,12 @@ WheelSpeeds Executor::step(const fusion::LocalizerEstimate& e) {
   if (status_ == ExecutorStatus::idle || status_ == ExecutorStatus::arrived ||
       status_ == ExecutorStatus::failed)
     return {};
-  if (e.mode == fusion::LocalizerMode::lost) {
+  if (!e.known()) {
     if (!lost_since_) {
       lost_since_ = e.stamp;
       status_ = ExecutorStatus::waiting;
-      note(e.stamp, "lost: stopped, waiting for relocalization");
+      note(e.stamp, std::string(fusion::to_string(e.mode)) +
+                        ": stopped, waiting for relocalization");
     } else if (to_seconds(e.stamp - *lost_since_) > o_.max_lost_s) {
       std::ostringstream why;
       why << "lost for more than " << o_.max_lost_s << " s";

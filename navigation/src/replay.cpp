@@ -88,6 +88,13 @@ struct Recorder : RuntimeObserver {
   ReplayResult* r;
   void on_estimate(const fusion::LocalizerEstimate& e) override {
     r->estimates.push_back({e.stamp, e.pose, e.covariance, e.mode, e.node ? e.node->name : ""});
+    // The hypotheses change with frames, not with odometry: kept when their number, the mode or
+    // the leader's weight changes.
+    const HypothesesSample* last = r->hypotheses.empty() ? nullptr : &r->hypotheses.back();
+    const bool changed =
+        !last || last->mode != e.mode || last->hypotheses.size() != e.hypotheses.size() ||
+        (!e.hypotheses.empty() && last->hypotheses.front().weight != e.hypotheses.front().weight);
+    if (changed) r->hypotheses.push_back({e.stamp, e.mode, e.hypotheses});
   }
   void on_ceiling(const FrameInput& f, const fusion::CeilingObservation& ob) override {
     LampFrame lf;
@@ -123,6 +130,17 @@ ErrorStats stats_of(const std::vector<double>& v) {
   return s;
 }
 
+// Why a replay never published a pose, in words: what the localizer last said.
+std::string never_localized(const ReplayResult& r, const io::MissionLog& log) {
+  std::string s = "the robot was never localized";
+  if (!r.events.empty()) s += ": " + r.events.back().reason;
+  else if (r.outcome.omni_frames == 0 && !log.omni_images.empty())
+    s += ": no omni frame could be used";
+  else if (r.outcome.omni_frames == 0)
+    s += ": no omni frame to find it with";
+  return s;
+}
+
 void score(ReplayResult& r, const io::MissionLog& log) {
   Metrics& m = r.metrics;
   m.ceiling_frames = r.outcome.ceiling_frames;
@@ -134,10 +152,12 @@ void score(ReplayResult& r, const io::MissionLog& log) {
       ++m.lamps_seen;
       if (l.label) ++m.lamps_labelled;
     }
-  // Time lost.
-  for (std::size_t k = 1; k < r.estimates.size(); ++k)
-    if (r.estimates[k - 1].mode == fusion::LocalizerMode::lost)
-      m.lost_s += to_seconds(r.estimates[k].stamp - r.estimates[k - 1].stamp);
+  // Time lost, time ambiguous.
+  for (std::size_t k = 1; k < r.estimates.size(); ++k) {
+    const double dt = to_seconds(r.estimates[k].stamp - r.estimates[k - 1].stamp);
+    if (r.estimates[k - 1].mode == fusion::LocalizerMode::lost) m.lost_s += dt;
+    if (r.estimates[k - 1].mode == fusion::LocalizerMode::ambiguous) m.ambiguous_s += dt;
+  }
   // Kidnaps and the fixes after them.
   std::vector<Stamp> kidnaps, fixes;
   for (const auto& e : log.events)
@@ -178,6 +198,30 @@ void score(ReplayResult& r, const io::MissionLog& log) {
   }
   m.position_error_m = stats_of(pos);
   m.yaw_error_deg = stats_of(yaw);
+  // Wrong fixes: a pose published as certain more than 0.5 m off, except between a kidnap and
+  // the localizer noticing it (the first mode change after it).
+  std::vector<std::pair<Stamp, Stamp>> unnoticed;
+  for (const Stamp k : kidnaps) {
+    Stamp until = Stamp::max();
+    for (const auto& e : r.events)
+      if (e.stamp >= k && e.mode != fusion::LocalizerMode::tracking) {
+        until = e.stamp;
+        break;
+      }
+    unnoticed.emplace_back(k, until);
+  }
+  bool wrong = false;
+  for (const auto& e : r.estimates) {
+    const bool certain = e.mode == fusion::LocalizerMode::tracking ||
+                         e.mode == fusion::LocalizerMode::relocalized;
+    bool excused = false;
+    for (const auto& [from, to] : unnoticed)
+      if (e.stamp >= from && e.stamp < to) excused = true;
+    const bool off = certain && !excused &&
+                     (e.pose.translation() - truth.at(e.stamp).translation()).norm() > 0.5;
+    if (off && !wrong) ++m.wrong_fixes;
+    wrong = off;
+  }
 }
 
 }  // namespace
@@ -224,9 +268,14 @@ ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
   for (const auto& e : ev)
     if (e.reason != "initialized") r.events.push_back(e);
   // Wheels alone, from the first pose the stack had.
-  if (!r.estimates.empty()) {
-    const Stamp from = r.estimates.front().stamp;
-    fusion::StateVector x = r.estimates.front().pose.vector();
+  const auto known = std::find_if(r.estimates.begin(), r.estimates.end(),
+                                  [](const EstimateSample& e) {
+                                    return e.mode == fusion::LocalizerMode::tracking ||
+                                           e.mode == fusion::LocalizerMode::relocalized;
+                                  });
+  if (known != r.estimates.end()) {
+    const Stamp from = known->stamp;
+    fusion::StateVector x = known->pose.vector();
     std::optional<std::pair<double, double>> last;
     for (const auto& w : log.wheels) {
       if (w.value.stamp < from) continue;
@@ -237,7 +286,7 @@ ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
       r.odometry.emplace_back(w.value.stamp, Pose2(x.x(), x.y(), wrap_angle(x.z())));
     }
   } else {
-    r.notes.push_back("the robot was never localized");
+    r.notes.push_back(never_localized(r, log));
   }
   score(r, log);
   r.metrics.realtime_factor =
@@ -316,6 +365,8 @@ std::string metrics_json(const Metrics& m) {
   j["position_error_m"] = err(m.position_error_m);
   j["yaw_error_deg"] = err(m.yaw_error_deg);
   j["lost_s"] = m.lost_s;
+  j["ambiguous_s"] = m.ambiguous_s;
+  j["wrong_fixes"] = m.has_truth ? Json(m.wrong_fixes) : Json(nullptr);
   j["kidnaps"] = m.kidnaps;
   j["recoveries"] = m.recoveries;
   j["relocalization_latency_s"] =
@@ -357,10 +408,19 @@ void write_replay(const ReplayResult& r, const io::MissionLog& log,
       w.write(e.stamp, p);
     }
     for (const auto& f : r.lamp_frames) w.write(f.arrival, f.observations);
+    for (const auto& h : r.hypotheses) {
+      io::Hypotheses msg;
+      msg.stamp = h.stamp;
+      msg.mode = fusion::to_string(h.mode);
+      for (const auto& p : h.hypotheses)
+        msg.hypotheses.push_back({p.pose, p.weight, p.node ? p.node->name : ""});
+      w.write(h.stamp, msg);
+    }
     w.close();
   }
-  std::vector<std::pair<Stamp, Pose2>> est;
-  for (const auto& e : r.estimates) est.emplace_back(e.stamp, e.pose);
+  std::vector<std::pair<Stamp, Pose2>> est;  // the poses published as tracking only (cli.md)
+  for (const auto& e : r.estimates)
+    if (e.mode == fusion::LocalizerMode::tracking) est.emplace_back(e.stamp, e.pose);
   write_text_file(dir + "/estimate.tum", tum(est));
   if (!log.truth.empty()) {
     const io::TruthTrack truth(log.truth);

@@ -245,19 +245,31 @@ std::string map_figure(const graph::TopologicalMap& map, const std::vector<Serie
   return s.str();
 }
 
+bool unsure(fusion::LocalizerMode m) {
+  return m == fusion::LocalizerMode::lost || m == fusion::LocalizerMode::ambiguous;
+}
+
+// Stretches lost (red) and ambiguous (orange).
 std::vector<Interval> lost_intervals(const ReplayResult& r, double t0) {
   std::vector<Interval> out;
   std::optional<double> from;
+  fusion::LocalizerMode mode = fusion::LocalizerMode::tracking;
+  auto color = [](fusion::LocalizerMode m) {
+    return m == fusion::LocalizerMode::lost ? "#d62728" : "#ff7f0e";
+  };
   for (const auto& e : r.estimates) {
     const double t = to_seconds(e.stamp) - t0;
-    if (e.mode == fusion::LocalizerMode::lost && !from) from = t;
-    if (e.mode != fusion::LocalizerMode::lost && from) {
-      out.push_back({*from, t, "#d62728"});
+    if (from && e.mode != mode) {
+      out.push_back({*from, t, color(mode)});
       from.reset();
+    }
+    if (unsure(e.mode) && !from) {
+      from = t;
+      mode = e.mode;
     }
   }
   if (from && !r.estimates.empty())
-    out.push_back({*from, to_seconds(r.estimates.back().stamp) - t0, "#d62728"});
+    out.push_back({*from, to_seconds(r.estimates.back().stamp) - t0, color(mode)});
   return out;
 }
 
@@ -278,7 +290,7 @@ std::vector<Figure> report_figures(const ReplayResult& r, const io::MissionLog& 
   }
   for (const auto& [t, p] : r.odometry) odo.points.emplace_back(p.x(), p.y());
   for (const auto& e : r.estimates) {
-    if (e.mode == fusion::LocalizerMode::lost) {
+    if (unsure(e.mode)) {
       if (!fused.points.empty() && std::isfinite(fused.points.back().first))
         fused.points.push_back(kGap);
       continue;
@@ -309,7 +321,7 @@ std::vector<Figure> report_figures(const ReplayResult& r, const io::MissionLog& 
     for (const auto& e : r.estimates) {
       const Pose2 t = truth.at(e.stamp);
       const double ts = to_seconds(e.stamp) - t0;
-      if (e.mode == fusion::LocalizerMode::lost) {
+      if (unsure(e.mode)) {
         if (!pos.points.empty() && std::isfinite(pos.points.back().first)) {
           pos.points.push_back(kGap);
           yaw.points.push_back(kGap);
@@ -335,6 +347,26 @@ std::vector<Figure> report_figures(const ReplayResult& r, const io::MissionLog& 
     norm.points.emplace_back(to_seconds(e.stamp) - t0, fusion::covariance_norm(e.covariance));
   figs.push_back({"covariance.svg", "Norm of the covariance over time (paper 2, Fig. 7; red: lost)",
                   line_chart({norm}, "time (s)", "covariance norm", lost, true)});
+  if (!r.hypotheses.empty()) {
+    // How many places the robot may be, and the leader's share (1 once one pose is known).
+    Series count{"hypotheses", "#ff7f0e", {}}, share{"leader's weight x 10", "#1f77b4", {}};
+    for (const auto& h : r.hypotheses) {
+      const double ts = to_seconds(h.stamp) - t0;
+      const bool known = !unsure(h.mode);
+      const double n = known ? 1.0 : static_cast<double>(h.hypotheses.size());
+      const double w = known ? 1.0 : h.hypotheses.empty() ? 0.0 : h.hypotheses.front().weight;
+      if (!count.points.empty()) {  // steps: the value holds until the next change
+        count.points.emplace_back(ts, count.points.back().second);
+        share.points.emplace_back(ts, share.points.back().second);
+      }
+      count.points.emplace_back(ts, n);
+      share.points.emplace_back(ts, 10 * w);
+    }
+    figs.push_back({"hypotheses.svg",
+                    "Places the robot may be, and the leader's share of the weight (red: lost; "
+                    "orange: ambiguous)",
+                    line_chart({count, share}, "time (s)", "hypotheses", lost)});
+  }
   Series seen{"lamps seen", "#ff7f0e", {}}, labelled{"labelled", "#1f77b4", {}};
   for (const auto& f : r.lamp_frames) {
     int l = 0;
@@ -376,10 +408,14 @@ std::string report_html(const ReplayResult& r, const io::MissionLog& log,
     row("heading error", "mean " + num(m.yaw_error_deg.mean) + "&deg;, RMS " +
                              num(m.yaw_error_deg.rms) + "&deg;, max " + num(m.yaw_error_deg.max) +
                              "&deg;");
+  } else if (m.has_truth) {
+    row("errors", "not scored: no pose was ever published as tracking");
   } else {
     row("errors", "not scored: the log has no truth");
   }
+  if (m.has_truth) row("wrong fixes (certain, more than 0.5 m off)", std::to_string(m.wrong_fixes));
   row("time lost", num(m.lost_s, 1) + " s");
+  row("time ambiguous (one of several places)", num(m.ambiguous_s, 1) + " s");
   row("kidnaps / recoveries", std::to_string(m.kidnaps) + " / " + std::to_string(m.recoveries));
   if (m.relocalization_latency_s.n)
     row("relocalization latency", "mean " + num(m.relocalization_latency_s.mean) + " s, max " +
@@ -396,7 +432,7 @@ std::string report_html(const ReplayResult& r, const io::MissionLog& log,
       h << "<li class=\"bad\">" << num(to_seconds(e.value.stamp) - t0, 2) << " s: kidnapped ("
         << escape(e.value.detail) << ")</li>\n";
   for (const auto& e : r.events)
-    h << "<li class=\"" << (e.mode == fusion::LocalizerMode::lost ? "bad" : "ok") << "\">"
+    h << "<li class=\"" << (unsure(e.mode) ? "bad" : "ok") << "\">"
       << num(to_seconds(e.stamp) - t0, 2) << " s: " << fusion::to_string(e.mode) << " ("
       << escape(e.reason) << ")</li>\n";
   h << "</ul>\n<h2>Figures</h2>\n";

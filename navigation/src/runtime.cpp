@@ -45,11 +45,11 @@ RunOutcome Runtime::run(Robot& robot, const std::optional<Pose2>& start,
       out.last = w->stamp;
       ++out.wheel_readings;
       localizer_.wheels(w->stamp, w->left, w->right);
-      if (!localizer_.initialized()) continue;
       const fusion::LocalizerEstimate e = localizer_.estimate();
+      if (!localizer_.initialized() && e.hypotheses.empty()) continue;
       obs.on_estimate(e);
       if (driving) {
-        if (executor_.status() == ExecutorStatus::idle && e.mode != fusion::LocalizerMode::lost)
+        if (executor_.status() == ExecutorStatus::idle && e.known())
           executor_.start(e.stamp, e.pose, commands);
         const WheelSpeeds s = executor_.step(e);
         robot.set_wheel_speeds(s.left, s.right);

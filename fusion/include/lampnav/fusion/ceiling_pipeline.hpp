@@ -16,6 +16,10 @@
 #include "lampnav/graph/map.hpp"
 #include "lampnav/vision/lamp_tracker.hpp"
 
+namespace lampnav::vision {
+class PinholeCamera;
+}
+
 namespace lampnav::fusion {
 
 struct LabellerOptions {
@@ -64,6 +68,13 @@ class LampLabeller {
 // lamp above the camera.
 vision::LampShapePrior shape_prior_for(const graph::TopologicalMap& map,
                                        const CameraDescription& camera);
+
+// Map lamps a pose (known within `covariance`) puts so well inside the image that, even 3 sigma
+// off, they would be in full view, and near which nothing was detected. 0 when the pose is too
+// uncertain (over 0.3 m) to say.
+int unseen_lamps(const graph::TopologicalMap& map, const vision::PinholeCamera& camera,
+                 const CeilingGeometry& geometry, const std::vector<vision::LampDetection>& lamps,
+                 const Pose2& pose, const Eigen::Matrix3d& covariance);
 
 struct CeilingPipelineOptions {
   vision::LampDetectorOptions detector;

@@ -67,6 +67,9 @@ struct LampPairOptions {
   int candidates = 48;            // hypotheses scored after voting
   int refined = 12;               // of those, refined by least squares
   bool restrict_to_graph = true;  // a pose must lie in a node's region
+  // Cells with at least this fraction of the top votes must all be scored for the search to call
+  // itself complete (GlobalLocalization::complete).
+  double complete_vote_fraction = 1.0;
 };
 
 struct GlobalLocalizerOptions {
@@ -101,6 +104,9 @@ struct GlobalLocalization {
   std::vector<PoseHypothesis> hypotheses;  // best first
   int plausible = 0;       // hypotheses within the ambiguity margin of the best (first ones)
   bool ambiguous = false;  // several distinct poses explain the image (symmetric ceiling)
+  // Every place the votes point to was scored and every plausible hypothesis returned: the
+  // true pose, if the image shows lamps of the map, is among the hypotheses.
+  bool complete = false;
   std::string why;         // why there is no hypothesis, or why it is ambiguous
   int blobs = 0;           // detections used
   int merit_evaluations = 0;
@@ -119,6 +125,21 @@ class GlobalLocalizer {
   // flood of specks give no hypothesis and say why. Deterministic.
   GlobalLocalization locate(const vision::OmniDetection& detection) const;
   GlobalLocalization locate(const vision::OmniDetection& detection, GlobalMethod method) const;
+  // Every pose that explains the image, for a multi-hypothesis localizer: method `default` with
+  // up to `cap` candidates scored, refined and returned, and cells down to `vote_fraction` of the
+  // top votes counted for completeness. `complete` says whether all of them fit under the cap.
+  GlobalLocalization enumerate(const vision::OmniDetection& detection, int cap,
+                               double vote_fraction) const;
+
+  // A pose scored against one image as the default method scores its candidates: -2 log
+  // likelihood (matched directions, lamps in clear view not seen, blobs nothing explains), for a
+  // pose known within position_sigma (m) and yaw_sigma (rad). Cheap: no least squares.
+  struct PoseScore {
+    double cost = 0;
+    int expected = 0, missing = 0, unexplained = 0, matched = 0;
+  };
+  PoseScore score(const Pose2& pose, double position_sigma, double yaw_sigma,
+                  const vision::OmniDetection& detection) const;
 
   // The hypothesis near a predicted pose (one known within position_sigma and yaw_sigma, as
   // odometry carries a hypothesis to the next image): matched, refined and scored as the default

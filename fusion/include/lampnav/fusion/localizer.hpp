@@ -1,19 +1,23 @@
 #pragma once
 // The localizer a robot runs: wheel readings, ceiling-camera frames (or labelled-lamp
-// observations from an outside pipeline), omnidirectional frames and global fixes go in, in the
-// order they arrive; out come the estimate at odometry rate, its covariance, the mode and the
-// node of the map the robot is in. Frames arrive late (paper 2: about 1 s): each is labelled
+// observations from an outside pipeline), omnidirectional frames (or their detections) and
+// global fixes go in, in the order they arrive; out come the estimate at odometry rate, its
+// covariance, the mode, the node of the map the robot is in, and, when it does not know, every
+// place it may be with its weight. Frames arrive late (paper 2: about 1 s): each is labelled
 // with the estimate at its capture time and applied there by the EKF.
 //
-// Modes: tracking (the estimate is trusted), lost (the kidnap monitor says the estimate is not
-// the robot: relocalization is requested, camera measurements are not applied), relocalized (a
-// global fix re-initialized the filter; the first accepted ceiling measurement, or a consistent
-// omni check, confirms it and the mode returns to tracking).
-//
-// Relocalization: while lost (or before any pose is known), each omni frame goes to the global
-// localizer. One hypothesis is a fix at once. Several (a symmetric ceiling) are kept as
-// candidates, each carried to the next omni frame by odometry and scored again there; when one
-// stands clearly ahead of the others it becomes the fix.
+// Modes:
+//  - tracking: one pose holds the evidence; the EKF follows it.
+//  - lost: the kidnap monitor says the estimate is not the robot (or the robot was never told
+//    where it starts), and the places it may be are not all known yet: nothing is published as
+//    certain.
+//  - ambiguous: every place the cameras' evidence fits is a hypothesis (HypothesisSet), and
+//    more than one still holds weight: "it is one of these", with the weights.
+//  - relocalized: one hypothesis came to hold the evidence (posterior and likelihood ratio over
+//    the runner-up, both options) and re-initialized the filter; the first accepted ceiling
+//    measurement, or a consistent omni check, confirms it and the mode returns to tracking.
+// A regular building (identical corridors and lamps) is the normal case: a pose is never
+// published as certain while a look-alike place explains the same images.
 
 #include <Eigen/Core>
 #include <memory>
@@ -26,6 +30,7 @@
 #include "lampnav/fusion/ceiling_pipeline.hpp"
 #include "lampnav/fusion/ekf.hpp"
 #include "lampnav/fusion/global_localizer.hpp"
+#include "lampnav/fusion/hypothesis_set.hpp"
 #include "lampnav/fusion/kidnap_monitor.hpp"
 #include "lampnav/fusion/odometry_calibration.hpp"
 #include "lampnav/graph/map.hpp"
@@ -34,7 +39,7 @@
 
 namespace lampnav::fusion {
 
-enum class LocalizerMode { tracking, lost, relocalized };
+enum class LocalizerMode { tracking, lost, relocalized, ambiguous };
 const char* to_string(LocalizerMode mode);
 
 struct LocalizerOptions {
@@ -46,12 +51,10 @@ struct LocalizerOptions {
   KidnapMonitorOptions kidnap;
   Duration omni_check_period = std::chrono::seconds(1);  // the low-rate omni check
   GlobalLocalizerOptions global;                         // relocalization from omni frames
+  HypothesisSetOptions hypotheses;                       // where the robot may be while unsure
   // While tracking, a consistent omni frame refines the estimate's pose on the lamps it matched
   // and is applied as a measurement (at least this many lamps; 0 turns it off).
   int omni_update_min_lamps = 4;
-  // Odometry drift allowed when carrying a candidate to the next omni frame.
-  double candidate_sigma_m = 0.15, candidate_sigma_per_m = 0.05;
-  double candidate_sigma_yaw_deg = 3.0;
   void validate() const;
 };
 
@@ -63,12 +66,22 @@ struct GlobalFix {
   std::string source;  // "omni", "operator", ...
 };
 
+// One place the robot may be, with its share of the evidence.
+struct WeightedPose {
+  Pose2 pose;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+  double weight = 0;
+  const graph::Node* node = nullptr;
+};
+
 struct LocalizerEstimate {
   Stamp stamp;
-  Pose2 pose;
+  Pose2 pose;  // lost or ambiguous: the most likely hypothesis (or the last estimate), NOT a fix
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
   LocalizerMode mode = LocalizerMode::tracking;
   const graph::Node* node = nullptr;  // the node whose region holds the pose, if any
+  std::vector<WeightedPose> hypotheses;  // lost or ambiguous: every place it may be, best first
+  bool known() const { return mode == LocalizerMode::tracking || mode == LocalizerMode::relocalized; }
 };
 
 struct LocalizerEvent {
@@ -86,14 +99,15 @@ struct LocalizerCounts {
   std::uint64_t fixes_refused = 0;
   std::uint64_t wheel_rebaselined = 0;      // after a refused jump, the new reading is the baseline
   std::uint64_t relocalization_frames = 0;  // omni frames given to the global localizer
-  std::uint64_t ambiguous_frames = 0;       // of those, with several candidates left
+  std::uint64_t ambiguous_frames = 0;       // of those, leaving several hypotheses
   std::uint64_t omni_updates = 0;           // omni pose measurements applied while tracking
 };
 
-// Where relocalization stands: the candidates kept and why the last frame did not settle it.
+// Where relocalization stands: the hypotheses and why they do not settle it yet.
 struct RelocalizationStatus {
-  std::vector<PoseHypothesis> candidates;  // at the last omni frame, best first
-  std::string why;                         // why there is no fix yet ("" once fixed)
+  HypothesisVerdict verdict = HypothesisVerdict::empty;
+  std::vector<WeightedPose> hypotheses;  // at the last frame that weighed them, best first
+  std::string why;                       // why there is no fix yet ("" once fixed)
 };
 
 class Localizer {
@@ -119,6 +133,8 @@ class Localizer {
   // An omnidirectional frame captured at `stamp`: detected, kept for relocalization, and (at
   // most once per omni_check_period, while tracking) checked against the estimate.
   const vision::OmniDetection& omni_frame(Stamp stamp, const vision::ImageView& image);
+  // The same with the frame's detections (from an outside detector, or a test).
+  void omni_detection(Stamp stamp, const vision::OmniDetection& detection);
   // A relocalized pose: re-initializes state and covariance at its capture time and re-applies
   // the odometry since. False (and counted) when it is older than the history or not finite.
   bool global_fix(const GlobalFix& fix);
@@ -129,6 +145,7 @@ class Localizer {
   LocalizerMode mode() const;
   bool relocalization_requested() const { return mode() == LocalizerMode::lost; }
   const RelocalizationStatus& relocalization() const;
+  const HypothesisSet& hypotheses() const;
   // The latest omni detection and its capture stamp.
   const vision::OmniDetection* last_omni() const;
   Stamp last_omni_stamp() const;

@@ -29,6 +29,7 @@ inline constexpr const char* kPose = "/lampnav/pose";
 inline constexpr const char* kEstimate = "/lampnav/estimate";
 inline constexpr const char* kLamps = "/lampnav/lamps";
 inline constexpr const char* kScene = "/lampnav/scene";
+inline constexpr const char* kHypotheses = "/lampnav/hypotheses";
 }  // namespace topics
 
 struct WheelReading {
@@ -65,7 +66,19 @@ struct PoseEstimate {
   Pose2 pose;
   std::array<double, 9> covariance{};  // row-major, x y yaw
   std::string node;                    // "" when in no region
-  std::string mode;                    // "tracking", "lost", "relocalized"
+  std::string mode;                    // "tracking", "lost", "relocalized", "ambiguous"
+};
+
+// Every place the robot may be while it does not know (/lampnav/hypotheses), with its weight.
+struct HypothesisEntry {
+  Pose2 pose;
+  double weight = 0;
+  std::string node;  // "" when in no region
+};
+struct Hypotheses {
+  Stamp stamp;
+  std::string mode;
+  std::vector<HypothesisEntry> hypotheses;  // best first; empty once one pose is known
 };
 
 // One frame's lamp detections (/lampnav/lamps): pixel centroid, orientation, area, track, label.
@@ -135,6 +148,7 @@ class MissionLogWriter {
   // Replay outputs: the estimate goes to both /lampnav/pose and /lampnav/estimate.
   void write(Stamp available, const PoseEstimate& e);
   void write(Stamp available, const LampObservations& o);
+  void write(Stamp available, const Hypotheses& h);
   void write(Stamp available, const SceneUpdate& u);
   void close();
 

@@ -64,6 +64,14 @@ struct EstimateSample {
   std::string node;
 };
 
+// The places the robot may be, whenever they change (lost and ambiguous); an empty list once one
+// pose is known.
+struct HypothesesSample {
+  Stamp stamp;
+  fusion::LocalizerMode mode = fusion::LocalizerMode::lost;
+  std::vector<fusion::WeightedPose> hypotheses;
+};
+
 struct LampFrame {
   Stamp arrival;
   io::LampObservations observations;
@@ -79,7 +87,11 @@ struct Metrics {
   double duration_s = 0;
   bool has_truth = false;
   ErrorStats position_error_m, yaw_error_deg;  // tracking, outside the lost intervals
-  double lost_s = 0;
+  double lost_s = 0;       // time lost (nothing published as certain, places not all known)
+  double ambiguous_s = 0;  // time with no single answer, every place it may be known
+  // With truth: stretches where a pose was published as certain (tracking or relocalized) more
+  // than 0.5 m off, outside the time from a kidnap to its detection.
+  int wrong_fixes = 0;
   int kidnaps = 0, recoveries = 0;
   ErrorStats relocalization_latency_s;  // from each kidnap to the fix that follows it
   std::size_t lamps_seen = 0, lamps_labelled = 0;
@@ -88,6 +100,7 @@ struct Metrics {
 
 struct ReplayResult {
   std::vector<EstimateSample> estimates;          // one per wheel reading, once a pose is known
+  std::vector<HypothesesSample> hypotheses;       // whenever they change
   std::vector<std::pair<Stamp, Pose2>> odometry;  // wheels alone, from the first pose
   std::vector<LampFrame> lamp_frames;             // ceiling frames with their detections
   std::vector<fusion::LocalizerEvent> events;     // the localizer's mode changes

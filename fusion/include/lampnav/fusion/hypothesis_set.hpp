@@ -1,0 +1,132 @@
+#pragma once
+// Where the robot may be when it does not know: a set of pose hypotheses, each a Gaussian
+// (pose and covariance at the capture time of the last frame that weighed it) carried between
+// frames by the shared dead reckoning, and weighed by BOTH cameras with one likelihood each:
+//  - omni frames: the global localizer's score of the hypothesis (matched directions, lamps in
+//    clear view not seen, blobs nothing explains) at the pose least squares refines it to, plus
+//    the Gaussian likelihood of that refinement under the hypothesis's prediction;
+//  - ceiling frames: each lamp in full view labelled from the hypothesis's prediction, a lamp
+//    with no map lamp inside its gate is unexplained, map lamps predicted well inside the view
+//    and not seen are missing, and the pose measured from the labelled lamps updates it.
+// The map bounds motion: a hypothesis carried out of every region (through a wall) dies.
+//
+// Hypotheses are born from omni global localization, enumerating every place the image fits
+// (GlobalLocalizer::enumerate). The set is COMPLETE once one image's enumeration held every such
+// place: from then on the true pose is one of the hypotheses (or the set is reset when every
+// hypothesis is contradicted), so a posterior over them means something. A pose is published
+// (winner()) only from a complete set whose leader holds at least `publish_posterior` of the
+// weight and `publish_ratio` times the runner-up's likelihood; otherwise the answer is "one of
+// these", with every hypothesis and its weight.
+
+#include <Eigen/Core>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "lampnav/core/robot_description.hpp"
+#include "lampnav/core/time.hpp"
+#include "lampnav/fusion/ceiling_pipeline.hpp"
+#include "lampnav/fusion/global_localizer.hpp"
+#include "lampnav/fusion/odometry_track.hpp"
+#include "lampnav/graph/map.hpp"
+
+namespace lampnav::fusion {
+
+struct HypothesisSetOptions {
+  double publish_posterior = 0.999;  // the leader's share of the weight needed to publish it
+  double publish_ratio = 1000;       // and its likelihood ratio over the runner-up
+  int min_omni_frames = 1;           // omni frames that weighed the set before it may publish
+  int max_hypotheses = 512;          // an image fitting more places leaves the set incomplete
+  double vote_fraction = 0.8;        // enumeration: cells with this share of the top votes count
+  double drop_ratio = 1e-9;          // hypotheses below this likelihood ratio to the best die
+  double frame_cost_cap = 12.0;      // -2 ln L one frame of one camera can cost a hypothesis:
+                                     // one odd frame (a person under a lamp) never decides alone
+  double kept_prior = 0.1;           // the tracking hypothesis's prior after a kidnap alarm
+  double merge_m = 0.3, merge_deg = 5.0;  // hypotheses closer than this are one
+  // Odometry error while carried: position sigma grows by sigma_per_m per metre travelled, yaw
+  // by sigma_yaw_deg_per_m (deg per metre); the floor: sigma_m, sigma_yaw_deg.
+  double sigma_m = 0.02, sigma_per_m = 0.03;
+  double sigma_yaw_deg = 0.5, sigma_yaw_deg_per_m = 1.0;
+  double wall_margin_m = 0.4;    // a pose this far outside every region went through a wall
+  double omni_bump_sigma_m = 0.06;      // floor bumps added to an omni refinement's covariance
+  double omni_bump_sigma_deg = 0.15;
+  double ceiling_miss_cost = 4.6;       // -2 ln 0.1, a lamp in clear view not seen
+  double ceiling_spurious_cost = 6.0;   // a lamp in full view no map lamp explains
+  void validate() const;                // throws InputError naming the field
+};
+
+enum class HypothesisOrigin { omni, kept };  // born from an omni image; the tracking estimate
+const char* to_string(HypothesisOrigin origin);
+
+struct Hypothesis {
+  int id = 0;
+  HypothesisOrigin origin = HypothesisOrigin::omni;
+  Stamp stamp;                                               // capture time it stands at
+  Pose2 pose;                                                // robot base in the map, at stamp
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // x, y, yaw
+  Pose2 odometry;           // the dead-reckoned pose at stamp
+  double log_weight = 0;    // log prior + log likelihood of every frame since the set began
+  double weight = 0;        // posterior share (the set's weights sum to 1)
+  double last_cost = 0;     // -2 ln L of the last frame that weighed it
+  bool contradicted = false;  // the last frame plainly contradicted it (never published then)
+  const graph::Node* node = nullptr;
+};
+
+// Why the set is as it is (for events, logs and people).
+enum class HypothesisVerdict {
+  empty,       // no hypothesis: nothing seen yet, or every one was contradicted
+  incomplete,  // some hypotheses, but the images fit more places than were enumerated
+  ambiguous,   // complete, several hypotheses hold the weight
+  decided,     // complete, one hypothesis holds it (winner())
+};
+const char* to_string(HypothesisVerdict verdict);
+
+class HypothesisSet {
+ public:
+  // `ceiling_camera` and `omni` (the global localizer, sharing its lamp index) may be null: that
+  // camera then weighs nothing. Throws InputError for bad options.
+  HypothesisSet(const graph::TopologicalMap& map, const CameraDescription* ceiling_camera,
+                const GlobalLocalizer* omni, const CeilingPipelineOptions& ceiling_options,
+                const HypothesisSetOptions& options = {});
+  ~HypothesisSet();
+  HypothesisSet(HypothesisSet&&) noexcept;
+
+  // Forgets every hypothesis; the set is empty and incomplete.
+  void clear();
+  // After a kidnap alarm: the estimate the robot was tracking stays a hypothesis, at
+  // `kept_prior`, until the images decide (a false alarm costs nothing but a few frames).
+  void keep(Stamp stamp, const Pose2& pose, const Eigen::Matrix3d& covariance,
+            const OdometryTrack& odometry);
+
+  // One omni frame captured at `stamp`: every hypothesis weighed and refined, and new ones born
+  // from it while the set is incomplete. A frame that plainly contradicts every hypothesis
+  // starts the set again.
+  void omni(Stamp stamp, const vision::OmniDetection& detection, const OdometryTrack& odometry);
+  // The lamps of one ceiling frame (full and completed views are used).
+  void ceiling(Stamp stamp, const std::vector<vision::LampDetection>& lamps,
+               const OdometryTrack& odometry);
+
+  // Best first.
+  const std::vector<Hypothesis>& hypotheses() const;
+  bool complete() const;
+  HypothesisVerdict verdict() const;
+  std::string why() const;  // the verdict in words
+  // The leader, when the set is decided.
+  const Hypothesis* winner() const;
+  // A hypothesis carried to `t` by odometry (pose and covariance).
+  Hypothesis carried(const Hypothesis& h, Stamp t, const OdometryTrack& odometry) const;
+
+  struct Counts {
+    std::uint64_t born = 0, merged = 0, through_walls = 0, dropped = 0, resets = 0,
+                  enumerations = 0, complete_enumerations = 0;
+  };
+  const Counts& counts() const;
+  const HypothesisSetOptions& options() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lampnav::fusion

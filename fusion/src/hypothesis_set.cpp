@@ -1,0 +1,469 @@
+#include "lampnav/fusion/hypothesis_set.hpp"
+
+#include <Eigen/LU>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <sstream>
+
+#include "lampnav/core/error.hpp"
+#include "lampnav/fusion/ceiling_geometry.hpp"
+#include "lampnav/vision/camera_models.hpp"
+
+namespace lampnav::fusion {
+
+namespace {
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kNegInf = -std::numeric_limits<double>::infinity();
+}  // namespace
+
+const char* to_string(HypothesisOrigin o) { return o == HypothesisOrigin::kept ? "kept" : "omni"; }
+
+const char* to_string(HypothesisVerdict v) {
+  switch (v) {
+    case HypothesisVerdict::empty:
+      return "empty";
+    case HypothesisVerdict::incomplete:
+      return "incomplete";
+    case HypothesisVerdict::ambiguous:
+      return "ambiguous";
+    case HypothesisVerdict::decided:
+      return "decided";
+  }
+  return "?";
+}
+
+void HypothesisSetOptions::validate() const {
+  auto check = [](bool ok, const char* field, const char* what) {
+    if (!ok) throw InputError({"", "hypothesis set options", field}, what);
+  };
+  check(publish_posterior > 0.5 && publish_posterior < 1, "publish_posterior",
+        "must be between 0.5 and 1");
+  check(publish_ratio >= 1, "publish_ratio", "must be at least 1");
+  check(min_omni_frames >= 1, "min_omni_frames", "must be at least 1");
+  check(max_hypotheses >= 1 && max_hypotheses <= 100000, "max_hypotheses", "must be 1 to 100000");
+  check(vote_fraction > 0 && vote_fraction <= 1, "vote_fraction", "must be in (0, 1]");
+  check(drop_ratio > 0 && drop_ratio < 1e-3, "drop_ratio", "must be in (0, 0.001)");
+  check(frame_cost_cap > 0, "frame_cost_cap", "must be positive");
+  check(kept_prior > 0 && kept_prior < 1, "kept_prior", "must be in (0, 1)");
+  check(merge_m > 0 && merge_deg > 0, "merge_m", "must be positive");
+  check(sigma_m > 0 && sigma_per_m >= 0 && sigma_yaw_deg > 0 && sigma_yaw_deg_per_m >= 0,
+        "sigma_m", "odometry sigmas must be positive");
+  check(wall_margin_m >= 0, "wall_margin_m", "must not be negative");
+  check(omni_bump_sigma_m >= 0 && omni_bump_sigma_deg >= 0, "omni_bump_sigma_m",
+        "must not be negative");
+  check(ceiling_miss_cost >= 0 && ceiling_spurious_cost >= 0, "ceiling_miss_cost",
+        "must not be negative");
+}
+
+struct HypothesisSet::Impl {
+  const graph::TopologicalMap* map;
+  HypothesisSetOptions o;
+  const GlobalLocalizer* omni;
+  std::optional<LampLabeller> labeller;
+  std::optional<CeilingGeometry> geometry;
+  std::optional<vision::PinholeCamera> camera;
+  PoseMeasurementOptions measurement;
+  bool has_regions = false;
+
+  std::vector<Hypothesis> hs;  // best first after every frame
+  bool complete = false;
+  int omni_frames = 0;   // omni frames that weighed the set since it became complete
+  int next_id = 1;
+  std::string last_why = "no omni image yet";
+  Counts counts;
+
+  Impl(const graph::TopologicalMap& m, const CameraDescription* ceiling_camera,
+       const GlobalLocalizer* g, const CeilingPipelineOptions& co, const HypothesisSetOptions& opt)
+      : map(&m), o(opt), omni(g), measurement(co.measurement) {
+    o.validate();
+    if (ceiling_camera) {
+      labeller.emplace(m, *ceiling_camera, co.labeller);
+      geometry.emplace(*ceiling_camera);
+      camera.emplace(*ceiling_camera);
+    }
+    for (const auto& n : m.nodes())
+      if (n.region.size() >= 3) has_regions = true;
+  }
+
+  // Whether a pose stands in (or within the margin of) some node's region.
+  bool inside(const Pose2& p) const {
+    if (!has_regions) return true;
+    const Eigen::Vector2d c = p.translation();
+    if (map->node_containing(c)) return true;
+    const double m = o.wall_margin_m;
+    if (m <= 0) return false;
+    for (int k = 0; k < 8; ++k) {
+      const double a = k * M_PI / 4;
+      if (map->node_containing(c + m * Eigen::Vector2d(std::cos(a), std::sin(a)))) return true;
+    }
+    return false;
+  }
+
+  Hypothesis carried(const Hypothesis& h, Stamp t, const OdometryTrack& odo) const {
+    Hypothesis c = h;
+    const Pose2 odo_t = odo.at(t);
+    const Pose2 delta = h.odometry.between(odo_t);
+    const double cy = std::cos(h.pose.yaw()), sy = std::sin(h.pose.yaw());
+    const double dx = delta.x(), dy = delta.y();
+    Eigen::Matrix3d F = Eigen::Matrix3d::Identity();
+    F(0, 2) = -sy * dx - cy * dy;
+    F(1, 2) = cy * dx - sy * dy;
+    const double travel = odo.travel(h.stamp, t);
+    const double sp = o.sigma_per_m * travel, syaw = o.sigma_yaw_deg_per_m * kDeg * travel;
+    c.pose = h.pose * delta;
+    c.covariance = F * h.covariance * F.transpose() +
+                   Eigen::Vector3d(sp * sp, sp * sp, syaw * syaw).asDiagonal().toDenseMatrix();
+    c.stamp = t;
+    c.odometry = odo_t;
+    return c;
+  }
+
+  // Kalman update of a hypothesis with a pose measurement; returns -2 ln N(z; x, S) less the
+  // constant.
+  double update(Hypothesis& h, const Pose2& z, const Eigen::Matrix3d& R) const {
+    const Eigen::Matrix3d S = h.covariance + R;
+    Eigen::Vector3d nu(z.x() - h.pose.x(), z.y() - h.pose.y(), wrap_angle(z.yaw() - h.pose.yaw()));
+    const Eigen::Matrix3d Si = S.inverse();
+    const Eigen::Matrix3d K = h.covariance * Si;
+    const Eigen::Vector3d dx = K * nu;
+    h.pose = Pose2(h.pose.x() + dx.x(), h.pose.y() + dx.y(), wrap_angle(h.pose.yaw() + dx.z()));
+    const Eigen::Matrix3d I_K = Eigen::Matrix3d::Identity() - K;
+    h.covariance = I_K * h.covariance * I_K.transpose() + K * R * K.transpose();
+    h.covariance = 0.5 * (h.covariance + h.covariance.transpose());
+    // A floor: a hypothesis is never surer than odometry between frames allows.
+    const double fp = o.sigma_m * o.sigma_m, fy = std::pow(o.sigma_yaw_deg * kDeg, 2);
+    if (h.covariance(0, 0) < fp) h.covariance(0, 0) = fp;
+    if (h.covariance(1, 1) < fp) h.covariance(1, 1) = fp;
+    if (h.covariance(2, 2) < fy) h.covariance(2, 2) = fy;
+    return nu.dot(Si * nu) + std::log(std::max(1e-300, S.determinant()));
+  }
+
+  static double sigma_position(const Eigen::Matrix3d& P) {
+    return std::sqrt(std::max(P(0, 0), P(1, 1)));
+  }
+
+  // What one frame says of one hypothesis: -2 ln L, and whether it plainly contradicts it (most
+  // of the lamps it predicts in clear view unseen, or most of the lamps seen unexplained).
+  struct Weighed {
+    double cost = 0;
+    bool contradicted = false;
+  };
+  static bool contradicts(int expected, int missing, int seen, int unexplained) {
+    return (expected >= 3 && 2 * missing > expected) || (seen >= 4 && 2 * unexplained > seen);
+  }
+
+  // An omni frame for one hypothesis (carried to the frame), updating it.
+  Weighed weigh_omni(Hypothesis& h, const vision::OmniDetection& d) const {
+    const double ps = std::clamp(sigma_position(h.covariance), 0.03, 1.5);
+    const double ys = std::clamp(std::sqrt(h.covariance(2, 2)), 0.5 * kDeg, 15 * kDeg);
+    const std::optional<PoseHypothesis> r = omni->refine(h.pose, ps, ys, d);
+    if (r && r->matches.size() >= 2) {
+      Eigen::Matrix3d R = r->covariance;
+      R.diagonal() += Eigen::Vector3d(o.omni_bump_sigma_m * o.omni_bump_sigma_m,
+                                      o.omni_bump_sigma_m * o.omni_bump_sigma_m,
+                                      std::pow(o.omni_bump_sigma_deg * kDeg, 2));
+      const int seen = static_cast<int>(r->matches.size()) + r->unexplained;
+      return {r->score + update(h, r->pose, R),
+              contradicts(r->expected, r->missing, seen, r->unexplained)};
+    }
+    // Nothing to refine on: the prediction scored as it stands, with its own uncertainty.
+    const GlobalLocalizer::PoseScore sc = omni->score(h.pose, ps, ys, d);
+    return {sc.cost,
+            contradicts(sc.expected, sc.missing, sc.matched + sc.unexplained, sc.unexplained)};
+  }
+
+  // Map lamps the hypothesis puts well inside the ceiling view with nothing detected near.
+  int missing(const std::vector<vision::LampDetection>& lamps, const Hypothesis& h) const {
+    return unseen_lamps(*map, *camera, *geometry, lamps, h.pose, h.covariance);
+  }
+
+  // A ceiling frame for one hypothesis (carried to the frame), updating it.
+  Weighed weigh_ceiling(Hypothesis& h, const std::vector<vision::LampDetection>& lamps) const {
+    std::vector<LabelledLamp> labelled;
+    std::set<LampId> taken;
+    int unexplained = 0;
+    for (const auto& d : lamps) {
+      if (d.view == vision::LampView::partial) continue;
+      const LabelResult r = labeller->label(d, h.pose, h.covariance, taken);
+      if (r.outcome == LabelOutcome::labelled) {
+        labelled.push_back({r.lamp, d});
+        taken.insert(r.lamp->id);
+      } else if (r.outcome == LabelOutcome::no_candidate) {
+        ++unexplained;
+      }
+    }
+    double cost = o.ceiling_spurious_cost * unexplained;
+    if (!lamps.empty()) cost += o.ceiling_miss_cost * missing(lamps, h);
+    if (!labelled.empty()) {
+      PoseRefusal refusal = PoseRefusal::none;
+      const std::optional<PoseMeasurement> m =
+          measure_pose(*geometry, camera->parameters().fx, labelled, h.pose, Stamp{}, measurement,
+                       nullptr, &refusal);
+      if (m)
+        cost += update(h, m->pose, m->covariance) -
+                std::log(std::max(1e-300, m->covariance.determinant()));
+      else if (refusal == PoseRefusal::labels_disagree)
+        cost += o.ceiling_spurious_cost;
+    }
+    return {cost, false};
+  }
+
+  // Carries every hypothesis to `stamp`, kills those that went through a wall, and weighs each
+  // with `weigh`; the costs of one frame are taken relative to the best and capped. Returns
+  // whether the frame contradicted every hypothesis.
+  template <class Weigh>
+  bool weigh_all(Stamp stamp, const OdometryTrack& odo, Weigh weigh) {
+    std::vector<Hypothesis> next;
+    std::vector<double> cost;
+    std::vector<char> contradicted;
+    bool all_contradicted = true;
+    next.reserve(hs.size());
+    for (const Hypothesis& h : hs) {
+      Hypothesis c = carried(h, stamp, odo);
+      if (!inside(c.pose)) {
+        ++counts.through_walls;
+        continue;
+      }
+      const Weighed w = weigh(c);
+      cost.push_back(w.cost);
+      contradicted.push_back(w.contradicted);
+      all_contradicted = all_contradicted && w.contradicted;
+      next.push_back(std::move(c));
+    }
+    double best = std::numeric_limits<double>::infinity();
+    for (double c : cost) best = std::min(best, c);
+    for (std::size_t k = 0; k < next.size(); ++k) {
+      next[k].last_cost = cost[k];
+      next[k].contradicted = contradicted[k];
+      next[k].log_weight -= 0.5 * std::min(o.frame_cost_cap, cost[k] - best);
+      next[k].node = map->node_containing(next[k].pose.translation());
+    }
+    hs = std::move(next);
+    return all_contradicted && !hs.empty();
+  }
+
+  // Merges near-duplicates (the likelier stays, their weights add), drops the unlikely, sorts
+  // best first and normalizes.
+  void tidy() {
+    std::stable_sort(hs.begin(), hs.end(), [](const Hypothesis& a, const Hypothesis& b) {
+      return a.log_weight > b.log_weight;
+    });
+    std::vector<Hypothesis> kept;
+    for (Hypothesis& h : hs) {
+      bool merged = false;
+      for (Hypothesis& k : kept)
+        if ((h.pose.translation() - k.pose.translation()).norm() < o.merge_m &&
+            std::abs(wrap_angle(h.pose.yaw() - k.pose.yaw())) < o.merge_deg * kDeg) {
+          const double m = std::max(k.log_weight, h.log_weight);
+          k.log_weight = m + std::log(std::exp(k.log_weight - m) + std::exp(h.log_weight - m));
+          if (h.origin == HypothesisOrigin::kept) k.origin = HypothesisOrigin::kept;
+          ++counts.merged;
+          merged = true;
+          break;
+        }
+      if (!merged) kept.push_back(std::move(h));
+    }
+    hs = std::move(kept);
+    if (hs.empty()) return;
+    const double floor = hs.front().log_weight + std::log(o.drop_ratio);
+    const std::size_t before = hs.size();
+    hs.erase(std::remove_if(hs.begin(), hs.end(),
+                            [&](const Hypothesis& h) { return !(h.log_weight >= floor); }),
+             hs.end());
+    if (int(hs.size()) > o.max_hypotheses) hs.resize(o.max_hypotheses);
+    counts.dropped += before - hs.size();
+    // Normalized so that the best is 0 (no drift to -inf over a long ambiguity).
+    const double top = hs.front().log_weight;
+    double total = 0;
+    for (Hypothesis& h : hs) {
+      h.log_weight -= top;
+      total += std::exp(h.log_weight);
+    }
+    for (Hypothesis& h : hs) h.weight = std::exp(h.log_weight) / total;
+  }
+
+  Hypothesis born(const PoseHypothesis& p, Stamp stamp, const OdometryTrack& odo,
+                  double log_weight) {
+    Hypothesis h;
+    h.id = next_id++;
+    h.origin = HypothesisOrigin::omni;
+    h.stamp = stamp;
+    h.pose = p.pose;
+    h.covariance = p.covariance;
+    h.covariance.diagonal() += Eigen::Vector3d(o.omni_bump_sigma_m * o.omni_bump_sigma_m,
+                                               o.omni_bump_sigma_m * o.omni_bump_sigma_m,
+                                               std::pow(o.omni_bump_sigma_deg * kDeg, 2));
+    h.odometry = odo.at(stamp);
+    h.log_weight = log_weight;
+    h.node = p.node;
+    ++counts.born;
+    return h;
+  }
+
+  // Births from one image's enumeration. A complete one starts the set again from every place
+  // it found, weighed by the image (the kept estimate, if still alive, keeps its prior share and
+  // what this image said of it, capped); an incomplete one only adds what is new, at the best
+  // weight (it was not weighed on earlier frames).
+  void births(Stamp stamp, const vision::OmniDetection& d, const OdometryTrack& odo) {
+    ++counts.enumerations;
+    const GlobalLocalization r = omni->enumerate(d, o.max_hypotheses, o.vote_fraction);
+    if (!r.found()) {
+      last_why = r.why;
+      return;
+    }
+    // Every hypothesis the drop ratio would keep: the runners-up make the likelihood ratio.
+    const double best_score = r.hypotheses.front().score;
+    const double margin = -2 * std::log(o.drop_ratio);
+    std::size_t n = 0;
+    while (n < r.hypotheses.size() && r.hypotheses[n].score <= best_score + margin) ++n;
+    if (r.complete) {
+      ++counts.complete_enumerations;
+      std::vector<Hypothesis> next;
+      double kept_share = 0;
+      for (const Hypothesis& h : hs)
+        if (h.origin == HypothesisOrigin::kept) {
+          next.push_back(h);
+          next.back().log_weight =
+              std::log(o.kept_prior) - 0.5 * std::min(o.frame_cost_cap, h.last_cost - best_score);
+          kept_share = o.kept_prior;
+        }
+      const double each = std::log((1 - kept_share) / double(std::max(1, r.plausible)));
+      for (std::size_t k = 0; k < n; ++k)
+        next.push_back(born(r.hypotheses[k], stamp, odo,
+                            each - 0.5 * (r.hypotheses[k].score - best_score)));
+      hs = std::move(next);
+      complete = true;
+      omni_frames = 1;  // this image weighed them
+      last_why.clear();
+      return;
+    }
+    last_why = r.why.empty() ? "the image fits more places than were enumerated" : r.why;
+    const double best = hs.empty() ? 0.0 : hs.front().log_weight;
+    for (std::size_t k = 0; k < n; ++k) hs.push_back(born(r.hypotheses[k], stamp, odo, best));
+  }
+
+  void reset(const std::string& why) {
+    ++counts.resets;
+    hs.clear();
+    complete = false;
+    omni_frames = 0;
+    last_why = why;
+  }
+};
+
+HypothesisSet::HypothesisSet(const graph::TopologicalMap& map,
+                             const CameraDescription* ceiling_camera, const GlobalLocalizer* omni,
+                             const CeilingPipelineOptions& ceiling_options,
+                             const HypothesisSetOptions& options)
+    : impl_(std::make_unique<Impl>(map, ceiling_camera, omni, ceiling_options, options)) {}
+HypothesisSet::~HypothesisSet() = default;
+HypothesisSet::HypothesisSet(HypothesisSet&&) noexcept = default;
+
+void HypothesisSet::clear() {
+  Impl& m = *impl_;
+  m.hs.clear();
+  m.complete = false;
+  m.omni_frames = 0;
+  m.last_why = "no omni image yet";
+}
+
+void HypothesisSet::keep(Stamp stamp, const Pose2& pose, const Eigen::Matrix3d& covariance,
+                         const OdometryTrack& odometry) {
+  Impl& m = *impl_;
+  clear();
+  Hypothesis h;
+  h.id = m.next_id++;
+  h.origin = HypothesisOrigin::kept;
+  h.stamp = stamp;
+  h.pose = pose;
+  h.covariance = covariance;
+  h.odometry = odometry.at(stamp);
+  h.log_weight = std::log(m.o.kept_prior);
+  h.weight = 1;
+  h.node = m.map->node_containing(pose.translation());
+  m.hs.push_back(h);
+  m.last_why = "the kidnap alarm fired: the tracked pose is one hypothesis among those the "
+               "omni camera will find";
+}
+
+void HypothesisSet::omni(Stamp stamp, const vision::OmniDetection& d,
+                         const OdometryTrack& odometry) {
+  Impl& m = *impl_;
+  if (!m.omni) return;
+  if (!m.hs.empty()) {
+    const bool all_contradicted =
+        m.weigh_all(stamp, odometry, [&](Hypothesis& h) { return m.weigh_omni(h, d); });
+    if (m.complete) ++m.omni_frames;
+    m.tidy();
+    // Every hypothesis contradicted: the robot is none of them (carried away again, or the set
+    // lost it). Starting again costs what was learnt, never the pose.
+    if (m.complete && (m.hs.empty() || all_contradicted))
+      m.reset(m.hs.empty() ? "every hypothesis went through a wall"
+                           : "the omni view contradicts every hypothesis");
+  }
+  if (!m.complete) {
+    m.births(stamp, d, odometry);
+    m.tidy();
+  }
+}
+
+void HypothesisSet::ceiling(Stamp stamp, const std::vector<vision::LampDetection>& lamps,
+                            const OdometryTrack& odometry) {
+  Impl& m = *impl_;
+  if (!m.labeller || m.hs.empty()) return;
+  m.weigh_all(stamp, odometry, [&](Hypothesis& h) { return m.weigh_ceiling(h, lamps); });
+  m.tidy();
+  if (m.complete && m.hs.empty()) m.reset("every hypothesis went through a wall");
+}
+
+const std::vector<Hypothesis>& HypothesisSet::hypotheses() const { return impl_->hs; }
+bool HypothesisSet::complete() const { return impl_->complete; }
+
+const Hypothesis* HypothesisSet::winner() const {
+  const Impl& m = *impl_;
+  if (!m.complete || m.hs.empty() || m.omni_frames < m.o.min_omni_frames) return nullptr;
+  const Hypothesis& best = m.hs.front();
+  if (best.weight < m.o.publish_posterior || best.contradicted) return nullptr;
+  if (m.hs.size() > 1 && m.hs[0].log_weight - m.hs[1].log_weight < std::log(m.o.publish_ratio))
+    return nullptr;
+  return &best;
+}
+
+HypothesisVerdict HypothesisSet::verdict() const {
+  const Impl& m = *impl_;
+  if (m.hs.empty()) return HypothesisVerdict::empty;
+  if (!m.complete) return HypothesisVerdict::incomplete;
+  return winner() ? HypothesisVerdict::decided : HypothesisVerdict::ambiguous;
+}
+
+std::string HypothesisSet::why() const {
+  const Impl& m = *impl_;
+  std::ostringstream s;
+  switch (verdict()) {
+    case HypothesisVerdict::empty:
+      return m.last_why.empty() ? "no hypothesis" : m.last_why;
+    case HypothesisVerdict::incomplete:
+      s << m.hs.size() << " hypotheses so far, but " << m.last_why;
+      return s.str();
+    case HypothesisVerdict::ambiguous:
+      s << m.hs.size() << " places explain what the cameras saw (best " << m.hs.front().weight
+        << (m.hs.front().node ? " in " + m.hs.front().node->name : std::string()) << ")";
+      if (m.omni_frames < m.o.min_omni_frames) s << ", waiting for another omni frame";
+      return s.str();
+    case HypothesisVerdict::decided:
+      return "one place holds the evidence";
+  }
+  return {};
+}
+
+Hypothesis HypothesisSet::carried(const Hypothesis& h, Stamp t,
+                                  const OdometryTrack& odometry) const {
+  return impl_->carried(h, t, odometry);
+}
+
+const HypothesisSet::Counts& HypothesisSet::counts() const { return impl_->counts; }
+const HypothesisSetOptions& HypothesisSet::options() const { return impl_->o; }
+
+}  // namespace lampnav::fusion
