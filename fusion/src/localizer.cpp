@@ -232,6 +232,7 @@ void Localizer::initialize(Stamp stamp, const Pose2& pose, const Eigen::Matrix3d
   m.ekf.initialize(stamp, pose, P);
   m.monitor.reset();
   if (m.pipeline) m.pipeline->reset();
+  m.hypotheses->clear();
   m.mode = LocalizerMode::tracking;
   m.events.push_back({stamp, LocalizerMode::tracking, "initialized"});
 }

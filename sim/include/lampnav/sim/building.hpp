@@ -1,10 +1,15 @@
 #pragma once
-// Generated buildings for the scale benchmarks (issue 8): a square grid of junctions (corners at
-// the grid's corners) joined by corridors, with rooms and their doors off the corridors, lamps
-// along every corridor and in every room. The same size and seed give the same map.
+// Generated buildings for the scale benchmarks and the localization batteries: a square grid of
+// junctions (corners at the grid's corners) joined by corridors, with rooms and their doors off
+// the corridors, lamps along every corridor, over every junction and in every room. With every
+// asymmetry off (no rooms, no missing corridor, one spacing, no lobby) the grid is perfectly
+// symmetric: a quarter turn maps it onto itself. The asymmetries real buildings have can be
+// switched on: a missing corridor, a wing with another lamp spacing, a lobby. The same options
+// and seed give the same map.
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace lampnav::sim {
 
@@ -13,13 +18,18 @@ struct BuildingOptions {
   double block_m = 20.0;         // junction spacing
   double lamp_spacing_m = 2.25;  // along corridors, as on the office floor
   double ceiling_m = 2.7;
-  std::uint64_t seed = 1;  // which blocks get rooms
+  bool rooms = true;          // rooms (seeded blocks) with their doors, to the node count
+  int missing_corridors = 0;  // corridors left out (seeded; the building stays connected)
+  double wing_lamp_spacing_m = 0;  // > 0: corridors east of the middle have this spacing
+  bool lobby = false;  // a hall of round lamps south-west of the corner junction at the origin
+  std::uint64_t seed = 1;  // which blocks get rooms, which corridors are missing
   void validate() const;   // throws InputError naming the field
 };
 
 struct Building {
   std::string geojson;  // map-format.md, reads back with graph::parse_map
   int nodes = 0, edges = 0, lamps = 0, grid = 0;
+  std::vector<std::string> missing;  // names of the corridors left out
 };
 
 Building generate_building(const BuildingOptions& options);
