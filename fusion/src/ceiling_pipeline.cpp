@@ -169,6 +169,10 @@ struct CeilingPipeline::Impl {
   CeilingGeometry geometry;
   std::map<int, const graph::Lamp*> label_of_track;
 
+  // Labels a frame's lamps and measures the pose; `tracked`: a track keeps its label.
+  CeilingObservation label(Stamp stamp, const vision::TrackedFrame& frame, const Pose2& predicted,
+                           const Matrix3d& P, bool tracked);
+
   Impl(const graph::TopologicalMap& m, const CameraDescription& c,
        const CeilingPipelineOptions& opt)
       : camera(c),
@@ -194,33 +198,46 @@ void CeilingPipeline::reset() {
 CeilingObservation CeilingPipeline::process(Stamp stamp, const vision::ImageView& image,
                                             const Pose2& predicted, const Matrix3d& P) {
   Impl& m = *impl_;
-  const vision::TrackedFrame frame = m.tracker.process(image);
+  return m.label(stamp, m.tracker.process(image), predicted, P, true);
+}
+
+CeilingObservation CeilingPipeline::process(Stamp stamp,
+                                            const std::vector<vision::LampDetection>& lamps,
+                                            const Pose2& predicted, const Matrix3d& P) {
+  vision::TrackedFrame frame;
+  for (const auto& d : lamps) frame.lamps.push_back({0, 1, true, d});
+  return impl_->label(stamp, frame, predicted, P, false);
+}
+
+CeilingObservation CeilingPipeline::Impl::label(Stamp stamp, const vision::TrackedFrame& frame,
+                                                const Pose2& predicted, const Matrix3d& P,
+                                                bool tracked) {
   CeilingObservation out;
   out.stamp = stamp;
   out.detection = frame.stats;
   out.ended_tracks = frame.ended;
-  for (int id : frame.ended) m.label_of_track.erase(id);
+  for (int id : frame.ended) label_of_track.erase(id);
   // Lamps held by live tracks are not offered to new ones (one lamp, one track).
   std::set<LampId> taken;
   for (const auto& t : frame.lamps) {
-    const auto it = m.label_of_track.find(t.track_id);
-    if (it != m.label_of_track.end()) taken.insert(it->second->id);
+    const auto it = label_of_track.find(t.track_id);
+    if (tracked && it != label_of_track.end()) taken.insert(it->second->id);
   }
   std::vector<LabelledLamp> labelled;
   for (const auto& t : frame.lamps) {
     ObservedLamp ob;
     ob.track_id = t.track_id;
     ob.detection = t.detection;
-    const auto it = m.label_of_track.find(t.track_id);
-    if (it != m.label_of_track.end()) {
+    const auto it = tracked ? label_of_track.find(t.track_id) : label_of_track.end();
+    if (it != label_of_track.end()) {
       ob.lamp = it->second;
       ob.outcome = LabelOutcome::labelled;
     } else {
-      const LabelResult r = m.labeller.label(t.detection, predicted, P, taken);
+      const LabelResult r = labeller.label(t.detection, predicted, P, taken);
       ob.outcome = r.outcome;
       if (r.outcome == LabelOutcome::labelled) {
         ob.lamp = r.lamp;
-        m.label_of_track[t.track_id] = r.lamp;
+        if (tracked) label_of_track[t.track_id] = r.lamp;
         taken.insert(r.lamp->id);
       }
     }
@@ -230,8 +247,8 @@ CeilingObservation CeilingPipeline::process(Stamp stamp, const vision::ImageView
   }
   if (!labelled.empty()) {
     std::string why;
-    out.measurement = measure_pose(m.geometry, m.camera.pinhole.fx, labelled, predicted, stamp,
-                                   m.o.measurement, &why, &out.no_measurement);
+    out.measurement = measure_pose(geometry, camera.pinhole.fx, labelled, predicted, stamp,
+                                   o.measurement, &why, &out.no_measurement);
     if (!out.measurement) out.no_measurement_reason = why;
   } else if (!out.lamps.empty()) {
     out.no_measurement_reason = "no labelled lamp in full view";

@@ -219,6 +219,45 @@ struct Localizer::Impl {
     }
     lose(monitor.ceiling(e));
   }
+  // A ceiling frame, through `process(pose, covariance)` (the pipeline on an image or on outside
+  // detections). While unsure, its lamps weigh every hypothesis (labelled from the likeliest
+  // place only so that the tracker keeps going).
+  template <class Process>
+  const CeilingObservation& ceiling(Stamp stamp, Process process, Localizer& self) {
+    last_ceiling = CeilingObservation{};
+    last_ceiling.stamp = stamp;
+    const std::optional<FilterState> prior = self.prior_at(stamp);
+    if (unsure()) {
+      Pose2 pose;
+      Eigen::Matrix3d P = Eigen::Vector3d(100, 100, 10).asDiagonal();
+      const auto& hs = hypotheses->hypotheses();
+      if (!hs.empty()) {
+        const Hypothesis c = hypotheses->carried(hs.front(), stamp, odometry);
+        pose = c.pose;
+        P = c.covariance;
+      } else if (prior) {
+        pose = prior->pose();
+        P = prior->P;
+      }
+      last_ceiling = process(pose, P);
+      ++counts.ceiling_frames;
+      ++counts.frames_while_lost;
+      if (hs.empty()) return last_ceiling;
+      std::vector<vision::LampDetection> lamps;
+      for (const auto& l : last_ceiling.lamps) lamps.push_back(l.detection);
+      hypotheses->ceiling(stamp, lamps, odometry);
+      settle(stamp, self);
+      return last_ceiling;
+    }
+    if (!prior) {
+      ++counts.frames_too_old;
+      last_ceiling.no_measurement_reason = "captured before the filter's history";
+      return last_ceiling;
+    }
+    last_ceiling = process(prior->pose(), prior->P);
+    observe(last_ceiling, *prior);
+    return last_ceiling;
+  }
 };
 
 Localizer::Localizer(const graph::TopologicalMap& map, const RobotDescription& robot,
@@ -269,43 +308,21 @@ std::optional<FilterState> Localizer::prior_at(Stamp stamp) const {
 
 const CeilingObservation& Localizer::ceiling_frame(Stamp stamp, const vision::ImageView& image) {
   Impl& m = *impl_;
-  m.last_ceiling = CeilingObservation{};
-  m.last_ceiling.stamp = stamp;
   if (!m.pipeline)
     throw InputError({"", "robot.json", "cameras"}, "the robot has no ceiling_camera");
-  const std::optional<FilterState> prior = prior_at(stamp);
-  if (m.unsure()) {
-    // Detected and tracked as usual (labelled from the likeliest place, which no one uses); the
-    // lamps weigh every hypothesis.
-    Pose2 pose;
-    Eigen::Matrix3d P = Eigen::Vector3d(100, 100, 10).asDiagonal();
-    const auto& hs = m.hypotheses->hypotheses();
-    if (!hs.empty()) {
-      const Hypothesis c = m.hypotheses->carried(hs.front(), stamp, m.odometry);
-      pose = c.pose;
-      P = c.covariance;
-    } else if (prior) {
-      pose = prior->pose();
-      P = prior->P;
-    }
-    m.last_ceiling = m.pipeline->process(stamp, image, pose, P);
-    ++m.counts.ceiling_frames;
-    ++m.counts.frames_while_lost;
-    if (hs.empty()) return m.last_ceiling;
-    std::vector<vision::LampDetection> lamps;
-    for (const auto& l : m.last_ceiling.lamps) lamps.push_back(l.detection);
-    m.hypotheses->ceiling(stamp, lamps, m.odometry);
-    m.settle(stamp, *this);
-    return m.last_ceiling;
-  }
-  if (!prior) {
-    ++m.counts.frames_too_old;
-    m.last_ceiling.no_measurement_reason = "captured before the filter's history";
-    return m.last_ceiling;
-  }
-  m.last_ceiling = m.pipeline->process(stamp, image, prior->pose(), prior->P);
-  m.observe(m.last_ceiling, *prior);
-  return m.last_ceiling;
+  return m.ceiling(stamp, [&](const Pose2& pose, const Eigen::Matrix3d& P) {
+    return m.pipeline->process(stamp, image, pose, P);
+  }, *this);
+}
+
+const CeilingObservation& Localizer::ceiling_detections(
+    Stamp stamp, const std::vector<vision::LampDetection>& lamps) {
+  Impl& m = *impl_;
+  if (!m.pipeline)
+    throw InputError({"", "robot.json", "cameras"}, "the robot has no ceiling_camera");
+  return m.ceiling(stamp, [&](const Pose2& pose, const Eigen::Matrix3d& P) {
+    return m.pipeline->process(stamp, lamps, pose, P);
+  }, *this);
 }
 
 void Localizer::ceiling_observation(const CeilingObservation& ob) {

@@ -112,6 +112,9 @@ class CeilingPipeline {
   // Throws InputError for a frame that is not an image of the camera (nothing else changes).
   CeilingObservation process(Stamp stamp, const vision::ImageView& image, const Pose2& predicted,
                              const Eigen::Matrix3d& covariance);
+  // Lamps found by an outside detector, untracked: each is labelled afresh (track id 0).
+  CeilingObservation process(Stamp stamp, const std::vector<vision::LampDetection>& lamps,
+                             const Pose2& predicted, const Eigen::Matrix3d& covariance);
   // Forgets the tracks and their labels (after a kidnap: the old labels are worthless).
   void reset();
 

@@ -128,6 +128,9 @@ class Localizer {
   // A ceiling-camera frame captured at `stamp`. Throws InputError for a frame that is not an
   // image of the camera; nothing changes then.
   const CeilingObservation& ceiling_frame(Stamp stamp, const vision::ImageView& image);
+  // The lamps of a ceiling frame found by an outside detector (untracked: labelled afresh).
+  const CeilingObservation& ceiling_detections(Stamp stamp,
+                                               const std::vector<vision::LampDetection>& lamps);
   // An observation made by an outside ceiling pipeline (labelled with prior_at(stamp)).
   void ceiling_observation(const CeilingObservation& observation);
   // An omnidirectional frame captured at `stamp`: detected, kept for relocalization, and (at

@@ -1,0 +1,284 @@
+#include "battery.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include "lampnav/graph/planner.hpp"
+
+namespace lampnav::test {
+
+namespace {
+
+using Eigen::Vector2d;
+constexpr double kDeg = M_PI / 180.0;
+
+bool known(fusion::LocalizerMode m) {
+  return m == fusion::LocalizerMode::tracking || m == fusion::LocalizerMode::relocalized;
+}
+
+// Where a person at the joystick goes: along the corridor the robot stands in, towards the end
+// it faces, then by the planned route to a junction drawn at random, and so on.
+class Driver {
+ public:
+  Driver(const graph::TopologicalMap& map, std::mt19937_64& rng) : map_(&map), rng_(&rng) {
+    for (const auto& n : map.nodes())
+      if (n.place == graph::Place::junction || n.place == graph::Place::corner ||
+          n.place == graph::Place::end)
+        goals_.push_back(&n);
+  }
+
+  void plan_from(const Pose2& pose) {
+    waypoints_.clear();
+    const graph::Node* here = map_->node_containing(pose.translation());
+    last_ = here;
+    if (!here || !here->axis) return;
+    Vector2d dir = here->axis->direction();
+    const Vector2d heading(std::cos(pose.yaw()), std::sin(pose.yaw()));
+    const bool forward = dir.dot(heading) >= 0;
+    const Vector2d end = forward ? here->axis->second : here->axis->first;
+    waypoints_.push_back(end);
+    // The node beyond that end.
+    const graph::Node* next = nullptr;
+    double best = 1e18;
+    for (const graph::Edge* e : map_->out_edges(here->id)) {
+      const graph::Node& n = map_->node(e->end);
+      const double d = (n.point - end).norm();
+      if (d < best) {
+        best = d;
+        next = &n;
+      }
+    }
+    if (next) {
+      waypoints_.push_back(next->point);
+      last_ = next;
+    }
+  }
+
+  // Body speeds (m/s, rad/s) towards the next waypoint: turn on the spot when far off the
+  // bearing, else drive with a proportional correction.
+  std::pair<double, double> command(const Pose2& pose, double speed) {
+    while (!waypoints_.empty() && (waypoints_.front() - pose.translation()).norm() < 0.25)
+      waypoints_.pop_front();
+    if (waypoints_.empty()) extend();
+    if (waypoints_.empty()) return {0.0, 0.6};
+    const Vector2d d = waypoints_.front() - pose.translation();
+    const double e = wrap_angle(std::atan2(d.y(), d.x()) - pose.yaw());
+    if (std::abs(e) > 0.35) return {0.0, e > 0 ? 0.8 : -0.8};
+    return {speed, std::clamp(2.0 * e, -0.8, 0.8)};
+  }
+
+ private:
+  void extend() {
+    if (!last_ || goals_.empty()) return;
+    for (int tries = 0; tries < 8; ++tries) {
+      const graph::Node* goal = goals_[(*rng_)() % goals_.size()];
+      if (goal == last_) continue;
+      const auto route = graph::plan_route(*map_, last_->id, goal->id);
+      if (!route) continue;
+      const auto pts = graph::route_waypoints(*map_, *route);
+      for (std::size_t k = 1; k < pts.size(); ++k) waypoints_.push_back(pts[k]);
+      last_ = goal;
+      return;
+    }
+  }
+
+  const graph::TopologicalMap* map_;
+  std::mt19937_64* rng_;
+  std::vector<const graph::Node*> goals_;
+  std::deque<Vector2d> waypoints_;
+  const graph::Node* last_ = nullptr;
+};
+
+}  // namespace
+
+struct Battery::Impl {
+  const graph::TopologicalMap* map;
+  RobotDescription robot;
+  BatteryOptions o;
+  fusion::LocalizerOptions lo;
+  sim::LampSensors sensors;
+  std::vector<const graph::Node*> corridors;
+
+  Impl(const graph::TopologicalMap& m, const RobotDescription& r, const BatteryOptions& opt,
+       const fusion::LocalizerOptions& l)
+      : map(&m), robot(r), o(opt), lo(l), sensors(m, r, opt.sensors) {
+    for (const auto& n : m.nodes())
+      if (n.place == graph::Place::corridor && n.axis) corridors.push_back(&n);
+  }
+
+  // Anywhere along a corridor (not within 0.5 m of its ends), at any heading.
+  Pose2 random_place(std::mt19937_64& rng) const {
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    const graph::Node& n = *corridors[rng() % corridors.size()];
+    const double len = n.axis->length();
+    const Vector2d p = n.axis->point_at(0.5 + u(rng) * std::max(0.0, len - 1.0));
+    return {p, wrap_angle(2 * M_PI * u(rng))};
+  }
+
+  // Drives from `start` and scores. With `kidnap_at_m` the localizer starts tracking at the truth
+  // and the robot is put down elsewhere after that much travel; without, it is never told.
+  EpisodeResult run(Pose2 truth, std::optional<double> kidnap_at_m, std::uint64_t seed) {
+    std::mt19937_64 rng(seed * 7919 + 17);
+    std::normal_distribution<double> n01(0.0, 1.0);
+    const double scale_l = 1 + o.odometry_scale_sigma * n01(rng);
+    const double scale_r = 1 + o.odometry_scale_sigma * n01(rng);
+    fusion::Localizer loc(*map, robot, lo);
+    Driver driver(*map, rng);
+    driver.plan_from(truth);
+    EpisodeResult r;
+    const double dt = 0.02, b = robot.semi_axis;
+    double left = 0, right = 0, travel = 0, t = 0;
+    double next_ceiling = 0.013, next_omni = 0.021;
+    struct Pending {
+      double at;
+      double capture;
+      bool ceiling;
+      std::vector<vision::LampDetection> lamps;
+      vision::OmniDetection omni;
+    };
+    std::deque<Pending> pending;  // in arrival order (each camera's delay is fixed)
+    auto stamp = [](double s) { return Stamp(std::chrono::nanoseconds(std::llround(s * 1e9))); };
+    if (kidnap_at_m)
+      loc.initialize(stamp(0), truth, Eigen::Vector3d(1e-4, 1e-4, 3e-4).asDiagonal());
+    std::optional<double> kidnapped_at, kidnap_travel, detected_at, fixed_at;
+    bool wrong = false;
+    std::optional<fusion::LocalizerMode> mode;
+    while (true) {
+      // Truth and wheels.
+      const auto [v, w] = driver.command(truth, o.speed);
+      truth = truth * Pose2(v * dt, 0.0, w * dt);
+      const double dl = (v - w * b) * dt, dr = (v + w * b) * dt;
+      const double nl = o.odometry_noise * std::sqrt(std::abs(dl)) * n01(rng);
+      const double nr = o.odometry_noise * std::sqrt(std::abs(dr)) * n01(rng);
+      left += dl * scale_l + nl;
+      right += dr * scale_r + nr;
+      travel += 0.5 * (std::abs(dl) + std::abs(dr));
+      t += dt;
+      if (kidnap_at_m && !kidnapped_at && travel >= *kidnap_at_m) {
+        truth = random_place(rng);
+        driver.plan_from(truth);
+        kidnapped_at = t;
+        kidnap_travel = travel;
+      }
+      loc.wheels(stamp(t), left, right);
+      // Frames captured now, delivered after their delay.
+      if (t >= next_ceiling && o.ceiling_rate > 0) {
+        next_ceiling += 1.0 / o.ceiling_rate;
+        pending.push_back({t + o.ceiling_delay_s, t, true, sensors.ceiling(truth, rng), {}});
+      }
+      if (t >= next_omni && o.omni_rate > 0) {
+        next_omni += 1.0 / o.omni_rate;
+        pending.push_back({t + o.omni_delay_s, t, false, {}, sensors.omni(truth, rng)});
+      }
+      std::stable_sort(pending.begin(), pending.end(),
+                       [](const Pending& a, const Pending& c) { return a.at < c.at; });
+      const auto t0 = std::chrono::steady_clock::now();
+      while (!pending.empty() && pending.front().at <= t) {
+        const Pending& p = pending.front();
+        if (p.ceiling)
+          loc.ceiling_detections(stamp(p.capture), p.lamps);
+        else
+          loc.omni_detection(stamp(p.capture), p.omni);
+        ++r.frames;
+        pending.pop_front();
+      }
+      r.localizer_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      // Score what it publishes now.
+      const fusion::LocalizerEstimate e = loc.estimate();
+      const bool after = !kidnap_at_m || kidnapped_at;
+      if (after && !detected_at && kidnap_at_m && !known(e.mode)) detected_at = t;
+      if (after) {
+        r.max_hypotheses = std::max(r.max_hypotheses, e.hypotheses.size());
+        if (e.mode == fusion::LocalizerMode::ambiguous) r.ambiguous_s += dt;
+        if (e.mode == fusion::LocalizerMode::lost && (!kidnap_at_m || detected_at)) r.lost_s += dt;
+      }
+      const bool excused = kidnap_at_m && kidnapped_at && !detected_at;
+      const double err = (e.pose.translation() - truth.translation()).norm();
+      const double yaw_err = std::abs(wrap_angle(e.pose.yaw() - truth.yaw()));
+      const bool certain = loc.initialized() && known(e.mode);
+      const bool off = certain && !excused && err > 0.5;
+      if (off && !wrong) ++r.wrong_fixes;
+      wrong = off;
+      const bool fix_allowed = !kidnap_at_m || detected_at;
+      if (certain && fix_allowed && !fixed_at) {
+        fixed_at = t;
+        r.fixed = true;
+        r.fix_error_m = err;
+        r.fix_correct = err <= 0.5 && yaw_err <= 5 * kDeg;
+        const double from_t = kidnapped_at.value_or(0.0);
+        r.latency_s = t - from_t;
+        r.latency_m = travel - kidnap_travel.value_or(0.0);
+      }
+      mode = e.mode;
+      const double since = travel - kidnap_travel.value_or(0.0);
+      if (fixed_at && t - *fixed_at > o.after_fix_s) break;
+      if ((!kidnap_at_m || kidnapped_at) && since > o.max_travel_m) break;
+      if (t > 3600) break;
+    }
+    r.detected = kidnap_at_m && detected_at;
+    if (detected_at) r.detection_s = *detected_at - *kidnapped_at;
+    if (!r.fixed) r.last_why = loc.relocalization().why;
+    return r;
+  }
+};
+
+Battery::Battery(const graph::TopologicalMap& map, const RobotDescription& robot,
+                 const BatteryOptions& options, const fusion::LocalizerOptions& localizer)
+    : impl_(std::make_unique<Impl>(map, robot, options, localizer)) {}
+Battery::~Battery() = default;
+
+EpisodeResult Battery::kidnap(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  Pose2 start = impl_->random_place(rng);
+  // Tracking starts facing along the corridor, as a robot does.
+  const graph::Node* n = impl_->map->node_containing(start.translation());
+  if (n && n->axis) {
+    const Vector2d d = n->axis->direction();
+    start = Pose2(start.translation(), std::atan2(d.y(), d.x()) + (rng() % 2 ? M_PI : 0.0));
+  }
+  return impl_->run(start, impl_->o.tracking_before_m, seed);
+}
+
+EpisodeResult Battery::unknown_start(std::uint64_t seed) {
+  std::mt19937_64 rng(seed);
+  return impl_->run(impl_->random_place(rng), std::nullopt, seed);
+}
+
+EpisodeResult Battery::unknown_start_at(const Pose2& start, std::uint64_t seed) {
+  return impl_->run(start, std::nullopt, seed);
+}
+
+std::string summarize(const std::vector<EpisodeResult>& rs) {
+  int detected = 0, fixed = 0, correct = 0, wrong = 0;
+  std::vector<double> lat_s, lat_m;
+  std::size_t hyp = 0;
+  for (const auto& r : rs) {
+    detected += r.detected;
+    fixed += r.fixed;
+    correct += r.fix_correct;
+    wrong += r.wrong_fixes;
+    hyp = std::max(hyp, r.max_hypotheses);
+    if (r.fixed) {
+      lat_s.push_back(r.latency_s);
+      lat_m.push_back(r.latency_m);
+    }
+  }
+  auto pct = [](std::vector<double> v, double q) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    return v[std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5))];
+  };
+  std::ostringstream s;
+  s << rs.size() << " episodes: " << detected << " detected, " << fixed << " fixed, " << correct
+    << " correct, " << wrong << " wrong fixes; latency median " << pct(lat_s, 0.5) << " s / "
+    << pct(lat_m, 0.5) << " m, p95 " << pct(lat_s, 0.95) << " s / " << pct(lat_m, 0.95)
+    << " m; at most " << hyp << " hypotheses";
+  return s.str();
+}
+
+}  // namespace lampnav::test

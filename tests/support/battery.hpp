@@ -1,0 +1,72 @@
+#pragma once
+// A battery for multi-hypothesis localization: a robot driven through a building (a person at
+// the joystick: along corridors, a random way at each junction), with noisy odometry and the
+// lamp detections of both cameras (sim::LampSensors, no rendering) delivered late as on the real
+// robot, fed to the Localizer in arrival order. Episodes: kidnaps (tracking, then put down
+// anywhere in a corridor at any heading) and unknown starts; each is scored against the truth:
+// detected, relocalized to the true place, wrong fixes (a pose published as certain more than
+// 0.5 m off), latency in seconds and metres, hypotheses at most. Shared by tests and bench.
+
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "lampnav/core/robot_description.hpp"
+#include "lampnav/fusion/localizer.hpp"
+#include "lampnav/graph/map.hpp"
+#include "lampnav/sim/lamp_sensors.hpp"
+
+namespace lampnav::test {
+
+struct EpisodeResult {
+  bool detected = false;     // kidnap: the localizer left tracking after it
+  bool fixed = false;        // a pose was published as certain after the kidnap / start
+  bool fix_correct = false;  // ... within 0.5 m and 5 degrees of the truth
+  int wrong_fixes = 0;       // stretches published as certain more than 0.5 m off (excused:
+                             // between a kidnap and its detection)
+  double fix_error_m = 0;    // of the first fix
+  double latency_s = 0, latency_m = 0;  // kidnap (or start) to the first fix
+  double detection_s = 0;               // kidnap to detection
+  std::size_t max_hypotheses = 0;
+  double ambiguous_s = 0, lost_s = 0;
+  double localizer_s = 0;  // wall time in the localizer
+  std::size_t frames = 0;  // camera frames given to it
+  std::string last_why;    // the localizer's last word when it never fixed
+};
+
+struct BatteryOptions {
+  double speed = 0.5;             // m/s
+  double ceiling_rate = 10, omni_rate = 1;  // Hz
+  double ceiling_delay_s = 1.0, omni_delay_s = 0.5;
+  double odometry_scale_sigma = 0.005;  // per wheel, drawn per episode
+  double odometry_noise = 0.002;        // m per sqrt(m) of wheel travel
+  double tracking_before_m = 4.0;       // kidnap: driven while tracking before it
+  double max_travel_m = 150.0;          // after the kidnap / start, at most
+  double after_fix_s = 10.0;            // driven on after the first fix, to catch a wrong one
+  sim::LampSensorOptions sensors;
+};
+
+class Battery {
+ public:
+  Battery(const graph::TopologicalMap& map, const RobotDescription& robot,
+          const BatteryOptions& options = {}, const fusion::LocalizerOptions& localizer = {});
+  ~Battery();
+
+  // Tracking from a random corridor place, then lifted and put down at another random corridor
+  // place, any heading.
+  EpisodeResult kidnap(std::uint64_t seed);
+  // Not told where it starts: a random corridor place, any heading.
+  EpisodeResult unknown_start(std::uint64_t seed);
+  // From a given pose, not told where it is, driving the given waypoints (then at random).
+  EpisodeResult unknown_start_at(const Pose2& start, std::uint64_t seed);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+std::string summarize(const std::vector<EpisodeResult>& results);
+
+}  // namespace lampnav::test
