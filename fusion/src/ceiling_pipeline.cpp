@@ -40,6 +40,7 @@ void LabellerOptions::validate() const {
   if (!(tilt_sigma >= 0 && tilt_sigma < 0.5)) fail("tilt_sigma", "must be 0 to 0.5 rad");
   if (!(map_sigma > 0)) fail("map_sigma", "must be positive");
   if (!(candidate_radius > 0)) fail("candidate_radius", "must be positive");
+  if (!(shape_tolerance > 0)) fail("shape_tolerance", "must be positive");
 }
 
 void CeilingPipelineOptions::validate() const {
@@ -87,6 +88,14 @@ LabelResult LampLabeller::label(const vision::LampDetection& d, const Pose2& pre
     if (!n) continue;
     ++r.candidates;
     const double dz = lamp->xyz.z() - geometry_.mount_origin().z();
+    if (d.view == vision::LampView::full && d.length > 0 && dz > 0) {
+      // Identical lamps are told apart by geometry; different ones by their size too.
+      const double tol = o_.shape_tolerance;
+      const double wide = lamp->width > 0 ? lamp->width : lamp->length;
+      if (std::abs(d.length * dz - lamp->length) > tol * lamp->length ||
+          std::abs(d.width * dz - wide) > tol * std::max(wide, 0.5 * lamp->length))
+        continue;
+    }
     const double sn = o_.pixel_sigma / fx_, sm = o_.map_sigma / dz;
     // Innovation on (centre, axis). The axis turns with the heading one for one (an upward
     // camera); round lamps have no axis and are gated on the centre alone.

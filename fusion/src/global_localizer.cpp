@@ -437,14 +437,11 @@ GlobalLocalization GlobalLocalizer::locate(const vision::OmniDetection& d,
 }
 
 GlobalLocalization GlobalLocalizer::enumerate(const vision::OmniDetection& d, int cap,
-                                              double vote_fraction) const {
+                                              double margin) const {
   const Impl& m = *impl_;
   GlobalLocalization out;
   if (d.flooded || m.lamps.empty() || d.blobs.empty()) return locate(d, GlobalMethod::lamp_pairs);
-  LampPairOptions q = m.o.pairs;
-  q.candidates = q.refined = std::max(1, cap);
-  q.complete_vote_fraction = std::clamp(vote_fraction, 1e-3, 1.0);
-  return m.lamp_pairs(d, q, std::max(1, cap));
+  return m.exhaustive(d, std::max(1, cap), std::max(0.0, margin));
 }
 
 GlobalLocalizer::PoseScore GlobalLocalizer::score(const Pose2& pose, double position_sigma,

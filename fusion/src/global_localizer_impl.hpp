@@ -166,6 +166,9 @@ struct GlobalLocalizer::Impl {
   GlobalLocalization lamp_pairs(const vision::OmniDetection& d, const LampPairOptions& q,
                                 int max_hypotheses) const;
 
+  // Every pose the lamps nearest the optical axis allow (global_localizer.hpp, enumerate()).
+  GlobalLocalization exhaustive(const vision::OmniDetection& d, int cap, double margin) const;
+
   // Ranks, merges near-duplicates, weighs, places on the graph, and says whether it is ambiguous.
   void finish(GlobalLocalization& out, std::vector<PoseHypothesis> hs,
               const vision::OmniDetection& d, const LampPairOptions& q, int max_hypotheses) const;

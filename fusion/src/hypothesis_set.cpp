@@ -43,9 +43,12 @@ void HypothesisSetOptions::validate() const {
   check(publish_ratio >= 1, "publish_ratio", "must be at least 1");
   check(min_omni_frames >= 1, "min_omni_frames", "must be at least 1");
   check(max_hypotheses >= 1 && max_hypotheses <= 100000, "max_hypotheses", "must be 1 to 100000");
-  check(vote_fraction > 0 && vote_fraction <= 1, "vote_fraction", "must be in (0, 1]");
   check(drop_ratio > 0 && drop_ratio < 1e-3, "drop_ratio", "must be in (0, 0.001)");
+  check(birth_ratio >= drop_ratio && birth_ratio < 1, "birth_ratio", "must be in [drop_ratio, 1)");
+  check(refined >= 0, "refined", "must not be negative");
   check(frame_cost_cap > 0, "frame_cost_cap", "must be positive");
+  check(ceiling_cost_cap > 0, "ceiling_cost_cap", "must be positive");
+  check(birth_sigma_m > 0 && birth_sigma_deg > 0, "birth_sigma_m", "must be positive");
   check(kept_prior > 0 && kept_prior < 1, "kept_prior", "must be in (0, 1)");
   check(merge_m > 0 && merge_deg > 0, "merge_m", "must be positive");
   check(sigma_m > 0 && sigma_per_m >= 0 && sigma_yaw_deg > 0 && sigma_yaw_deg_per_m >= 0,
@@ -154,11 +157,12 @@ struct HypothesisSet::Impl {
     return (expected >= 3 && 2 * missing > expected) || (seen >= 4 && 2 * unexplained > seen);
   }
 
-  // An omni frame for one hypothesis (carried to the frame), updating it.
-  Weighed weigh_omni(Hypothesis& h, const vision::OmniDetection& d) const {
+  // An omni frame for one hypothesis (carried to the frame), updating it when `refine`.
+  Weighed weigh_omni(Hypothesis& h, const vision::OmniDetection& d, bool refine) const {
     const double ps = std::clamp(sigma_position(h.covariance), 0.03, 1.5);
     const double ys = std::clamp(std::sqrt(h.covariance(2, 2)), 0.5 * kDeg, 15 * kDeg);
-    const std::optional<PoseHypothesis> r = omni->refine(h.pose, ps, ys, d);
+    const std::optional<PoseHypothesis> r =
+        refine ? omni->refine(h.pose, ps, ys, d) : std::nullopt;
     if (r && r->matches.size() >= 2) {
       Eigen::Matrix3d R = r->covariance;
       R.diagonal() += Eigen::Vector3d(o.omni_bump_sigma_m * o.omni_bump_sigma_m,
@@ -214,7 +218,7 @@ struct HypothesisSet::Impl {
   // with `weigh`; the costs of one frame are taken relative to the best and capped. Returns
   // whether the frame contradicted every hypothesis.
   template <class Weigh>
-  bool weigh_all(Stamp stamp, const OdometryTrack& odo, Weigh weigh) {
+  bool weigh_all(Stamp stamp, const OdometryTrack& odo, double cap, Weigh weigh) {
     std::vector<Hypothesis> next;
     std::vector<double> cost;
     std::vector<char> contradicted;
@@ -237,7 +241,7 @@ struct HypothesisSet::Impl {
     for (std::size_t k = 0; k < next.size(); ++k) {
       next[k].last_cost = cost[k];
       next[k].contradicted = contradicted[k];
-      next[k].log_weight -= 0.5 * std::min(o.frame_cost_cap, cost[k] - best);
+      next[k].log_weight -= 0.5 * std::min(cap, cost[k] - best);
       next[k].node = map->node_containing(next[k].pose.translation());
     }
     hs = std::move(next);
@@ -291,10 +295,12 @@ struct HypothesisSet::Impl {
     h.origin = HypothesisOrigin::omni;
     h.stamp = stamp;
     h.pose = p.pose;
+    // One image's least squares knows its noise, not the floor's bumps nor its own aliasing: a
+    // newborn is held loosely until the next frames have refined it.
     h.covariance = p.covariance;
-    h.covariance.diagonal() += Eigen::Vector3d(o.omni_bump_sigma_m * o.omni_bump_sigma_m,
-                                               o.omni_bump_sigma_m * o.omni_bump_sigma_m,
-                                               std::pow(o.omni_bump_sigma_deg * kDeg, 2));
+    h.covariance.diagonal() += Eigen::Vector3d(o.birth_sigma_m * o.birth_sigma_m,
+                                               o.birth_sigma_m * o.birth_sigma_m,
+                                               std::pow(o.birth_sigma_deg * kDeg, 2));
     h.odometry = odo.at(stamp);
     h.log_weight = log_weight;
     h.node = p.node;
@@ -308,14 +314,14 @@ struct HypothesisSet::Impl {
   // weight (it was not weighed on earlier frames).
   void births(Stamp stamp, const vision::OmniDetection& d, const OdometryTrack& odo) {
     ++counts.enumerations;
-    const GlobalLocalization r = omni->enumerate(d, o.max_hypotheses, o.vote_fraction);
+    const double margin = -2 * std::log(o.birth_ratio);
+    const GlobalLocalization r = omni->enumerate(d, o.max_hypotheses, margin);
     if (!r.found()) {
       last_why = r.why;
       return;
     }
-    // Every hypothesis the drop ratio would keep: the runners-up make the likelihood ratio.
+    // Every hypothesis within the birth ratio: the runners-up make the likelihood ratio.
     const double best_score = r.hypotheses.front().score;
-    const double margin = -2 * std::log(o.drop_ratio);
     std::size_t n = 0;
     while (n < r.hypotheses.size() && r.hypotheses[n].score <= best_score + margin) ++n;
     if (r.complete) {
@@ -393,8 +399,11 @@ void HypothesisSet::omni(Stamp stamp, const vision::OmniDetection& d,
   Impl& m = *impl_;
   if (!m.omni) return;
   if (!m.hs.empty()) {
+    // Best first: the likeliest are refined, the rest scored where they stand.
+    int rank = 0;
     const bool all_contradicted =
-        m.weigh_all(stamp, odometry, [&](Hypothesis& h) { return m.weigh_omni(h, d); });
+        m.weigh_all(stamp, odometry, m.o.frame_cost_cap,
+                    [&](Hypothesis& h) { return m.weigh_omni(h, d, rank++ < m.o.refined); });
     if (m.complete) ++m.omni_frames;
     m.tidy();
     // Every hypothesis contradicted: the robot is none of them (carried away again, or the set
@@ -413,7 +422,8 @@ void HypothesisSet::ceiling(Stamp stamp, const std::vector<vision::LampDetection
                             const OdometryTrack& odometry) {
   Impl& m = *impl_;
   if (!m.labeller || m.hs.empty()) return;
-  m.weigh_all(stamp, odometry, [&](Hypothesis& h) { return m.weigh_ceiling(h, lamps); });
+  m.weigh_all(stamp, odometry, m.o.ceiling_cost_cap,
+              [&](Hypothesis& h) { return m.weigh_ceiling(h, lamps); });
   m.tidy();
   if (m.complete && m.hs.empty()) m.reset("every hypothesis went through a wall");
 }

@@ -152,3 +152,136 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
 }
 
 }  // namespace lampnav::fusion
+
+namespace lampnav::fusion {
+
+using namespace detail;
+
+// Every pose that puts a map lamp under each of two blobs near the optical axis: the pair of
+// blobs matched to every pair of map lamps spaced like them (both ways round), for the three
+// pairs of the three blobs nearest the axis, so that one spurious or merged blob among them
+// cannot hide the true pose. The other seeds must mostly land on lamps too (a cheap check
+// through the map's spatial index) before a pose is scored; the plausible ones are refined.
+GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection& d, int cap,
+                                                     double margin) const {
+  const LampPairOptions& q = o.pairs;
+  GlobalLocalization out;
+  out.method = GlobalMethod::lamp_pairs;
+  const std::vector<BlobRay> blobs = blob_rays(d, q.max_theta_deg * kDeg);
+  out.blobs = static_cast<int>(blobs.size());
+  std::vector<BlobRay> seeds;
+  for (const BlobRay& b : blobs)
+    if (b.theta <= q.pair_max_theta_deg * kDeg && (mount_R * b.ray).z() > 0.05) seeds.push_back(b);
+  std::sort(seeds.begin(), seeds.end(),
+            [](const BlobRay& a, const BlobRay& b) { return a.theta < b.theta; });
+  if (seeds.size() > 6) seeds.resize(6);
+  if (seeds.size() < 2) {
+    out.why = std::to_string(seeds.size()) + " lamp(s) within " +
+              std::to_string(int(q.pair_max_theta_deg)) +
+              " degrees of the optical axis: a pose needs two";
+    return out;
+  }
+  const double sa = std::hypot(q.detection_sigma_deg, q.tilt_sigma_deg) * kDeg;
+  const std::size_t nc = classes.size(), ns = seeds.size();
+  std::vector<Vector2d> at(ns * nc);
+  std::vector<double> sigma(ns * nc, -1);
+  for (std::size_t j = 0; j < ns; ++j) {
+    const Vector3d rb = mount_R * seeds[j].ray;
+    for (std::size_t c = 0; c < nc; ++c) {
+      const double h = classes[c].height;
+      if (h < 0.2) continue;
+      at[j * nc + c] = mount_t.head<2>() + (h / rb.z()) * rb.head<2>();
+      sigma[j * nc + c] = h * sa / (rb.z() * rb.z()) + 0.1 * classes[c].length;
+    }
+  }
+  // Candidate poses, one per 0.25 m x 3 degree cell.
+  std::unordered_map<std::int64_t, Pose2> cells;
+  const double cell_m = 0.25, cell_rad = 3 * kDeg;
+  const std::size_t first = std::min<std::size_t>(3, ns);
+  for (std::size_t j = 0; j < first; ++j)
+    for (std::size_t k = j + 1; k < first; ++k)
+      for (const auto& [key, group] : pair_groups) {
+        const double sj = sigma[j * nc + key.first], sk = sigma[k * nc + key.second];
+        if (sj < 0 || sk < 0) continue;
+        const Vector2d& qi = at[j * nc + key.first];
+        const Vector2d& ql = at[k * nc + key.second];
+        const Vector2d dq = ql - qi;
+        const double dn = dq.norm(), dq_angle = std::atan2(dq.y(), dq.x());
+        const double tol = 3 * std::hypot(sj, sk) + 0.02;
+        auto lo = std::lower_bound(group.begin(), group.end(), dn - tol,
+                                   [](const LampPair& p, double v) { return p.distance < v; });
+        for (auto it = lo; it != group.end() && it->distance <= dn + tol; ++it) {
+          const Vector2d Li = lamps[it->a]->xyz.head<2>(), Ll = lamps[it->b]->xyz.head<2>();
+          const double yaw = wrap_angle(it->angle - dq_angle);
+          const double c = std::cos(yaw), s = std::sin(yaw);
+          const Vector2d mid_q = 0.5 * (qi + ql), mid_L = 0.5 * (Li + Ll);
+          const Vector2d p =
+              mid_L - Vector2d(c * mid_q.x() - s * mid_q.y(), s * mid_q.x() + c * mid_q.y());
+          const std::int64_t cell_key = (std::int64_t(std::floor(p.x() / cell_m)) * 1000003 +
+                                         std::int64_t(std::floor(p.y() / cell_m))) *
+                                            1009 +
+                                        std::int64_t(std::floor((yaw + M_PI) / cell_rad));
+          cells.emplace(cell_key, Pose2(p, yaw));
+        }
+      }
+  // In the graph, and the other seeds on lamps (all but one of them).
+  std::vector<std::pair<std::int64_t, Pose2>> poses(cells.begin(), cells.end());
+  std::sort(poses.begin(), poses.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<std::pair<double, Pose2>> scored;
+  for (const auto& [key, pose] : poses) {
+    if (q.restrict_to_graph && has_regions && !node_of(pose)) continue;
+    int misses = 0;
+    const double c = std::cos(pose.yaw()), s = std::sin(pose.yaw());
+    for (std::size_t j = 0; j < ns && misses <= 1; ++j) {
+      bool on_lamp = false;
+      for (std::size_t cl = 0; cl < nc && !on_lamp; ++cl) {
+        if (sigma[j * nc + cl] < 0 || sigma[j * nc + cl] > 0.5) continue;
+        const Vector2d& b = at[j * nc + cl];
+        const Vector2d w = pose.translation() + Vector2d(c * b.x() - s * b.y(), s * b.x() + c * b.y());
+        const double r = 3 * sigma[j * nc + cl] + 0.3;
+        for (const graph::Lamp* l : map->lamps_within(w, r))
+          if (class_of[lamp_index.at(l)] == int(cl)) on_lamp = true;
+      }
+      if (!on_lamp) ++misses;
+    }
+    if (misses > 1) continue;
+    scored.emplace_back(evaluate(pose, {}, 0.3, 3 * kDeg, q.tilt_sigma_deg * kDeg, blobs).cost,
+                        pose);
+  }
+  out.merit_evaluations = static_cast<int>(scored.size());
+  if (scored.empty()) {
+    out.why = "no place of the map has lamps where the " + std::to_string(ns) +
+              " lamps nearest the zenith are seen";
+    return out;
+  }
+  std::stable_sort(scored.begin(), scored.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  // Refined: the coarse scores within reach of the best (a coarse pose is up to a cell off),
+  // at most four times the cap; then every refined pose within `margin` of the best must fit
+  // under the cap for the search to be complete.
+  const double reach = scored.front().first + margin + 30.0;
+  const std::size_t limit = 4 * std::size_t(cap);
+  std::vector<PoseHypothesis> refined;
+  std::size_t within = 0;
+  for (const auto& [cost, pose] : scored) {
+    if (cost > reach) break;
+    if (++within > limit) break;
+    PoseHypothesis h = refine(pose, 0.3, 3 * kDeg, blobs);
+    if (q.restrict_to_graph && has_regions && !node_of(h.pose)) continue;
+    refined.push_back(std::move(h));
+  }
+  finish(out, refined, d, q, static_cast<int>(limit));
+  std::size_t kept = 0;
+  for (const auto& h : out.hypotheses)
+    if (h.score <= out.hypotheses.front().score + margin) ++kept;
+  out.complete = out.found() && within <= limit && kept <= std::size_t(cap);
+  if (out.hypotheses.size() > std::size_t(cap)) out.hypotheses.resize(cap);
+  if (!out.complete && out.found())
+    out.why = std::to_string(std::max(kept, within)) +
+              " places fit the lamps near the zenith, more than the " + std::to_string(cap) +
+              " that can be followed: more images are needed";
+  return out;
+}
+
+}  // namespace lampnav::fusion

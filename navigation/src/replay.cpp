@@ -199,13 +199,13 @@ void score(ReplayResult& r, const io::MissionLog& log) {
   m.position_error_m = stats_of(pos);
   m.yaw_error_deg = stats_of(yaw);
   // Wrong fixes: a pose published as certain more than 0.5 m off, except between a kidnap and
-  // the localizer noticing it (the first mode change after it).
+  // the localizer noticing it (the first mode change after it), 10 s at most.
   std::vector<std::pair<Stamp, Stamp>> unnoticed;
   for (const Stamp k : kidnaps) {
-    Stamp until = Stamp::max();
+    Stamp until = k + std::chrono::seconds(10);
     for (const auto& e : r.events)
       if (e.stamp >= k && e.mode != fusion::LocalizerMode::tracking) {
-        until = e.stamp;
+        until = std::min(until, e.stamp);
         break;
       }
     unnoticed.emplace_back(k, until);

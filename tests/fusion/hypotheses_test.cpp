@@ -4,6 +4,7 @@
 // frames late as on the robot. The rule under test: never a pose published as certain that is
 // wrong; "it is one of these" is always allowed.
 
+#include <cstdlib>
 #include <iostream>
 
 #include "battery.hpp"
@@ -73,6 +74,80 @@ TEST(Hypotheses, GridOfficeKidnapsIntoLookAlikeCorridors) {
     EXPECT_TRUE(r.detected);
     EXPECT_TRUE(r.fix_correct);
   }
+}
+
+}  // namespace
+}  // namespace lampnav::fusion
+
+namespace lampnav::fusion {
+namespace {
+
+// A generated building with the asymmetries real ones have: rooms off some corridors, a missing
+// corridor, an east wing with another lamp spacing, a lobby.
+sim::BuildingOptions asymmetric(int nodes) {
+  sim::BuildingOptions o;
+  o.nodes = nodes;
+  o.missing_corridors = 1;
+  o.wing_lamp_spacing_m = 2.7;
+  o.lobby = true;
+  o.seed = 5;
+  return o;
+}
+
+// LAMPNAV_TRACE=1 prints the hypotheses after every omni frame.
+test::BatteryOptions traced() {
+  test::BatteryOptions o;
+  if (std::getenv("LAMPNAV_TRACE"))
+    o.trace = [](double t, const Pose2& truth, const Localizer& loc) {
+      const LocalizerEstimate e = loc.estimate();
+      double nearest = 1e9, nearest_w = 0;
+      for (const auto& h : e.hypotheses) {
+        const double d = (h.pose.translation() - truth.translation()).norm();
+        if (d < nearest) {
+          nearest = d;
+          nearest_w = h.weight;
+        }
+      }
+      std::cout << "t " << t << " truth " << truth << " " << to_string(e.mode) << " nearest "
+                << nearest << " w " << nearest_w << " complete " << loc.hypotheses().complete()
+                << " pose " << e.pose << " (" << loc.relocalization().why << ")";
+      const auto& hs = loc.hypotheses().hypotheses();
+      for (std::size_t k = 0; k < hs.size() && k < 4; ++k)
+        std::cout << " [" << hs[k].pose << " w " << hs[k].weight << " c " << hs[k].last_cost
+                  << "]";
+      std::cout << "\n";
+    };
+  return o;
+}
+
+void kidnaps_on(int nodes, int episodes) {
+  const Building w(asymmetric(nodes));
+  test::Battery battery(w.map, w.robot, traced());
+  std::vector<test::EpisodeResult> rs;
+  for (int k = 1; k <= episodes; ++k) {
+    if (std::getenv("EPISODE") && k != std::atoi(std::getenv("EPISODE"))) continue;
+    rs.push_back(battery.kidnap(1000 + k));
+    const auto& r = rs.back();
+    EXPECT_EQ(r.wrong_fixes, 0) << "episode " << k;
+    EXPECT_TRUE(r.detected) << "episode " << k;
+    EXPECT_TRUE(r.fix_correct) << "episode " << k << ": " << r.last_why;
+  }
+  std::cout << w.b.nodes << " nodes, " << w.b.lamps << " lamps: " << test::summarize(rs) << "\n";
+}
+
+TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf10Nodes) { kidnaps_on(10, 10); }
+TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf100Nodes) { kidnaps_on(100, 10); }
+
+TEST(Hypotheses, UnknownStartsOnAGeneratedBuildingOf100Nodes) {
+  const Building w(asymmetric(100));
+  test::Battery battery(w.map, w.robot);
+  std::vector<test::EpisodeResult> rs;
+  for (int k = 1; k <= 8; ++k) {
+    rs.push_back(battery.unknown_start(2000 + k));
+    EXPECT_EQ(rs.back().wrong_fixes, 0) << "episode " << k;
+    EXPECT_TRUE(rs.back().fix_correct) << "episode " << k << ": " << rs.back().last_why;
+  }
+  std::cout << test::summarize(rs) << "\n";
 }
 
 }  // namespace

@@ -184,6 +184,7 @@ struct Battery::Impl {
           loc.ceiling_detections(stamp(p.capture), p.lamps);
         else
           loc.omni_detection(stamp(p.capture), p.omni);
+        if (o.trace) o.trace(t, truth, loc);
         ++r.frames;
         pending.pop_front();
       }
@@ -191,13 +192,17 @@ struct Battery::Impl {
       // Score what it publishes now.
       const fusion::LocalizerEstimate e = loc.estimate();
       const bool after = !kidnap_at_m || kidnapped_at;
-      if (after && !detected_at && kidnap_at_m && !known(e.mode)) detected_at = t;
+      // Noticed: the mode left tracking (lost, ambiguous, or a fix straight from the image that
+      // showed the loss).
+      if (after && !detected_at && kidnap_at_m && e.mode != fusion::LocalizerMode::tracking)
+        detected_at = t;
       if (after) {
         r.max_hypotheses = std::max(r.max_hypotheses, e.hypotheses.size());
         if (e.mode == fusion::LocalizerMode::ambiguous) r.ambiguous_s += dt;
         if (e.mode == fusion::LocalizerMode::lost && (!kidnap_at_m || detected_at)) r.lost_s += dt;
       }
-      const bool excused = kidnap_at_m && kidnapped_at && !detected_at;
+      // Between a kidnap and its detection the tracked pose is wrong by design, for 10 s at most.
+      const bool excused = kidnap_at_m && kidnapped_at && !detected_at && t - *kidnapped_at < 10;
       const double err = (e.pose.translation() - truth.translation()).norm();
       const double yaw_err = std::abs(wrap_angle(e.pose.yaw() - truth.yaw()));
       const bool certain = loc.initialized() && known(e.mode);

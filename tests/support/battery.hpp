@@ -8,6 +8,7 @@
 // 0.5 m off), latency in seconds and metres, hypotheses at most. Shared by tests and bench.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <random>
 #include <string>
@@ -25,7 +26,7 @@ struct EpisodeResult {
   bool fixed = false;        // a pose was published as certain after the kidnap / start
   bool fix_correct = false;  // ... within 0.5 m and 5 degrees of the truth
   int wrong_fixes = 0;       // stretches published as certain more than 0.5 m off (excused:
-                             // between a kidnap and its detection)
+                             // between a kidnap and its detection, 10 s at most)
   double fix_error_m = 0;    // of the first fix
   double latency_s = 0, latency_m = 0;  // kidnap (or start) to the first fix
   double detection_s = 0;               // kidnap to detection
@@ -43,9 +44,11 @@ struct BatteryOptions {
   double odometry_scale_sigma = 0.005;  // per wheel, drawn per episode
   double odometry_noise = 0.002;        // m per sqrt(m) of wheel travel
   double tracking_before_m = 4.0;       // kidnap: driven while tracking before it
-  double max_travel_m = 150.0;          // after the kidnap / start, at most
+  double max_travel_m = 300.0;          // after the kidnap / start, at most
   double after_fix_s = 10.0;            // driven on after the first fix, to catch a wrong one
   sim::LampSensorOptions sensors;
+  // Called after each frame the localizer took (for looking into a failing episode).
+  std::function<void(double t, const Pose2& truth, const fusion::Localizer&)> trace;
 };
 
 class Battery {

@@ -29,7 +29,10 @@ struct LabellerOptions {
   double tilt_sigma = 0.0087;       // rad, floor bumps
   double map_sigma = 0.005;         // m, survey error of the map's lamps
   double candidate_radius = 6.0;    // m, lamps considered when the pose is in no node's region
-  void validate() const;            // throws InputError naming the field
+  // A lamp seen whole whose size (long and short side, from the moments at the lamp's height)
+  // is off by more than this fraction is not that lamp: a strip light is not a round one.
+  double shape_tolerance = 0.35;
+  void validate() const;  // throws InputError naming the field
 };
 
 enum class LabelOutcome { labelled, no_candidate, ambiguous, partial_view };

@@ -125,11 +125,14 @@ class GlobalLocalizer {
   // flood of specks give no hypothesis and say why. Deterministic.
   GlobalLocalization locate(const vision::OmniDetection& detection) const;
   GlobalLocalization locate(const vision::OmniDetection& detection, GlobalMethod method) const;
-  // Every pose that explains the image, for a multi-hypothesis localizer: method `default` with
-  // up to `cap` candidates scored, refined and returned, and cells down to `vote_fraction` of the
-  // top votes counted for completeness. `complete` says whether all of them fit under the cap.
+  // Every pose that explains the image, for a multi-hypothesis localizer: each pair among the
+  // three blobs nearest the optical axis matched to every pair of map lamps spaced like it (not
+  // the most voted cells: on a regular ceiling votes rank look-alikes above the truth), poses
+  // outside the graph or with the other seeds off the lamps dropped, the rest scored, the
+  // plausible refined. `complete` says whether every refined pose within `margin` (-2 ln L) of
+  // the best fits under `cap` (then they are all returned, best first).
   GlobalLocalization enumerate(const vision::OmniDetection& detection, int cap,
-                               double vote_fraction) const;
+                               double margin) const;
 
   // A pose scored against one image as the default method scores its candidates: -2 log
   // likelihood (matched directions, lamps in clear view not seen, blobs nothing explains), for a

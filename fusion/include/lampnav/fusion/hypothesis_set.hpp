@@ -38,10 +38,15 @@ struct HypothesisSetOptions {
   double publish_ratio = 1000;       // and its likelihood ratio over the runner-up
   int min_omni_frames = 1;           // omni frames that weighed the set before it may publish
   int max_hypotheses = 512;          // an image fitting more places leaves the set incomplete
-  double vote_fraction = 0.8;        // enumeration: cells with this share of the top votes count
   double drop_ratio = 1e-9;          // hypotheses below this likelihood ratio to the best die
-  double frame_cost_cap = 12.0;      // -2 ln L one frame of one camera can cost a hypothesis:
-                                     // one odd frame (a person under a lamp) never decides alone
+  double birth_ratio = 1e-4;         // an image gives birth to the places within this ratio of
+                                     // its best (the truth's own noise stays far inside it)
+  int refined = 64;                  // the likeliest, refined by least squares on each omni
+                                     // frame; the others are only scored (cheap)
+  double frame_cost_cap = 12.0;      // -2 ln L one omni frame can cost a hypothesis: one odd
+                                     // frame (a person under a lamp) never decides alone
+  double ceiling_cost_cap = 2.0;     // the same for a ceiling frame: ten a second see the same
+                                     // lamps, so their evidence is far from independent
   double kept_prior = 0.1;           // the tracking hypothesis's prior after a kidnap alarm
   double merge_m = 0.3, merge_deg = 5.0;  // hypotheses closer than this are one
   // Odometry error while carried: position sigma grows by sigma_per_m per metre travelled, yaw
@@ -51,6 +56,7 @@ struct HypothesisSetOptions {
   double wall_margin_m = 0.4;    // a pose this far outside every region went through a wall
   double omni_bump_sigma_m = 0.06;      // floor bumps added to an omni refinement's covariance
   double omni_bump_sigma_deg = 0.15;
+  double birth_sigma_m = 0.1, birth_sigma_deg = 1.5;  // a hypothesis born from one image
   double ceiling_miss_cost = 4.6;       // -2 ln 0.1, a lamp in clear view not seen
   double ceiling_spurious_cost = 6.0;   // a lamp in full view no map lamp explains
   void validate() const;                // throws InputError naming the field
