@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -28,6 +29,8 @@ const char* to_string(HypothesisVerdict v) {
       return "incomplete";
     case HypothesisVerdict::ambiguous:
       return "ambiguous";
+    case HypothesisVerdict::symmetric:
+      return "symmetric";
     case HypothesisVerdict::decided:
       return "decided";
   }
@@ -46,6 +49,7 @@ void HypothesisSetOptions::validate() const {
   check(drop_ratio > 0 && drop_ratio < 1e-3, "drop_ratio", "must be in (0, 0.001)");
   check(birth_ratio >= drop_ratio && birth_ratio < 1, "birth_ratio", "must be in [drop_ratio, 1)");
   check(refined >= 0, "refined", "must not be negative");
+  check(symmetry_check_max >= 2, "symmetry_check_max", "must be at least 2");
   check(frame_cost_cap > 0, "frame_cost_cap", "must be positive");
   check(ceiling_cost_cap > 0, "ceiling_cost_cap", "must be positive");
   check(birth_sigma_m > 0 && birth_sigma_deg > 0, "birth_sigma_m", "must be positive");
@@ -76,6 +80,48 @@ struct HypothesisSet::Impl {
   int next_id = 1;
   std::string last_why = "no omni image yet";
   Counts counts;
+  mutable std::map<std::pair<int, int>, bool> twin_cache;  // by hypothesis ids
+
+  // Whether the rigid motion taking pose a to pose b maps every lamp of the map onto a lamp of
+  // the same shape and size (a rectangle's axis modulo a half turn): then the two places look
+  // alike from everywhere, whatever the robot does.
+  bool twins(const Hypothesis& a, const Hypothesis& b) const {
+    const auto key = std::minmax(a.id, b.id);
+    if (const auto it = twin_cache.find(key); it != twin_cache.end()) return it->second;
+    const Pose2 T = b.pose * a.pose.inverse();
+    const double c = std::cos(T.yaw()), s = std::sin(T.yaw());
+    bool all = true;
+    for (const auto& n : map->nodes()) {
+      for (const auto& l : n.lamps) {
+        const Eigen::Vector2d p = T.translation() + Eigen::Vector2d(c * l.xyz.x() - s * l.xyz.y(),
+                                                                    s * l.xyz.x() + c * l.xyz.y());
+        bool found = false;
+        for (const graph::Lamp* m : map->lamps_within(p, 0.15)) {
+          if (m->shape != l.shape || std::abs(m->length - l.length) > 0.05 ||
+              std::abs(m->width - l.width) > 0.05 || std::abs(m->xyz.z() - l.xyz.z()) > 0.05)
+            continue;
+          const bool round = l.shape == graph::LampShape::disc || l.length <= l.width;
+          const double d = wrap_angle(m->yaw - (l.yaw + T.yaw()));
+          if (round || std::abs(std::sin(d)) < std::sin(3 * kDeg)) found = true;
+        }
+        if (!found) {
+          all = false;
+          break;
+        }
+      }
+      if (!all) break;
+    }
+    twin_cache[key] = all;
+    return all;
+  }
+
+  // Every hypothesis holding weight is a twin of the leader.
+  bool all_twins() const {
+    if (hs.size() < 2 || int(hs.size()) > o.symmetry_check_max) return false;
+    for (std::size_t k = 1; k < hs.size(); ++k)
+      if (!twins(hs.front(), hs[k])) return false;
+    return true;
+  }
 
   Impl(const graph::TopologicalMap& m, const CameraDescription* ceiling_camera,
        const GlobalLocalizer* g, const CeilingPipelineOptions& co, const HypothesisSetOptions& opt)
@@ -372,6 +418,7 @@ void HypothesisSet::clear() {
   m.hs.clear();
   m.complete = false;
   m.omni_frames = 0;
+  m.twin_cache.clear();
   m.last_why = "no omni image yet";
 }
 
@@ -445,7 +492,8 @@ HypothesisVerdict HypothesisSet::verdict() const {
   const Impl& m = *impl_;
   if (m.hs.empty()) return HypothesisVerdict::empty;
   if (!m.complete) return HypothesisVerdict::incomplete;
-  return winner() ? HypothesisVerdict::decided : HypothesisVerdict::ambiguous;
+  if (winner()) return HypothesisVerdict::decided;
+  return m.all_twins() ? HypothesisVerdict::symmetric : HypothesisVerdict::ambiguous;
 }
 
 std::string HypothesisSet::why() const {
@@ -461,6 +509,12 @@ std::string HypothesisSet::why() const {
       s << m.hs.size() << " places explain what the cameras saw (best " << m.hs.front().weight
         << (m.hs.front().node ? " in " + m.hs.front().node->name : std::string()) << ")";
       if (m.omni_frames < m.o.min_omni_frames) s << ", waiting for another omni frame";
+      return s.str();
+    case HypothesisVerdict::symmetric:
+      s << "the building looks the same from " << m.hs.size() << " places (";
+      for (std::size_t k = 0; k < m.hs.size(); ++k)
+        s << (k ? ", " : "") << (m.hs[k].node ? m.hs[k].node->name : std::string("?"));
+      s << "): every lamp maps onto a lamp alike, so no motion can tell them apart";
       return s.str();
     case HypothesisVerdict::decided:
       return "one place holds the evidence";

@@ -140,7 +140,8 @@ struct Localizer::Impl {
         return;
       }
     }
-    if (relocalization.verdict == HypothesisVerdict::ambiguous) {
+    if (relocalization.verdict == HypothesisVerdict::ambiguous ||
+        relocalization.verdict == HypothesisVerdict::symmetric) {
       ++counts.ambiguous_frames;
       set_mode(LocalizerMode::ambiguous, relocalization.why);
     } else {
@@ -412,6 +413,8 @@ LocalizerEstimate Localizer::estimate() const {
     e.covariance = m.ekf.covariance();
   }
   if (m.unsure()) {
+    e.undecidable = m.relocalization.verdict == HypothesisVerdict::symmetric;
+    e.why = m.relocalization.why;
     e.hypotheses = m.weighted(e.stamp);
     if (!e.hypotheses.empty()) {
       e.pose = e.hypotheses.front().pose;

@@ -19,6 +19,9 @@ void ExecutorOptions::validate() const {
   check(goal_tolerance > 0, "goal_tolerance");
   check(max_lost_s > 0, "max_lost_s");
   check(off_route_m > 0, "off_route_m");
+  if (!(explore_m >= 0))
+    throw InputError({"", "executor options", "explore_m"}, "must not be negative");
+  check(explore_speed > 0, "explore_speed");
 }
 
 const char* to_string(ExecutorStatus s) {
@@ -84,6 +87,52 @@ bool Executor::adopt(Stamp stamp, const Pose2& pose,
   return true;
 }
 
+std::optional<WheelSpeeds> Executor::explore(const fusion::LocalizerEstimate& e) {
+  if (explore_stamp_ && e.stamp > *explore_stamp_)
+    explored_m_ += std::abs(explore_v_) * to_seconds(e.stamp - *explore_stamp_);
+  explore_stamp_ = e.stamp;
+  explore_v_ = 0;
+  if (explored_m_ >= o_.explore_m || e.hypotheses.empty()) return std::nullopt;
+  // How far the corridor runs ahead, in every place the robot may be: the motion must be
+  // possible in all of them.
+  const auto ahead = [&](const Pose2& p) -> std::optional<std::pair<double, Eigen::Vector2d>> {
+    const graph::Node* n = map_->node_containing(p.translation());
+    if (!n || !n->axis) return std::nullopt;
+    Eigen::Vector2d d = n->axis->direction();
+    if (d.dot(Eigen::Vector2d(std::cos(p.yaw()), std::sin(p.yaw()))) < 0) d = -d;
+    const Eigen::Vector2d end = d.dot(n->axis->second - n->axis->first) > 0 ? n->axis->second
+                                                                           : n->axis->first;
+    return std::pair{(end - p.translation()).dot(d), d};
+  };
+  const auto lead = ahead(e.pose);
+  if (!lead) return std::nullopt;
+  double reach = lead->first;
+  for (const auto& h : e.hypotheses) {
+    const auto a = ahead(h.pose);
+    if (!a) return std::nullopt;  // one of them stands at a junction: wait for the views
+    reach = std::min(reach, a->first);
+  }
+  // To the end of the shortest, and a metre into the place beyond it, where views differ.
+  const double go = reach + 1.0;
+  if (go < 0.3) return std::nullopt;
+  const Eigen::Vector2d target = e.pose.translation() + go * lead->second;
+  const Eigen::Vector2d to = target - e.pose.translation();
+  const double err = wrap_angle(std::atan2(to.y(), to.x()) - e.pose.yaw());
+  double v = 0, w = 0;
+  if (std::abs(err) > 0.35) {
+    w = std::copysign(std::min(o_.max_turn_rate, 0.6), err);
+  } else {
+    v = o_.explore_speed;
+    w = std::clamp(2.0 * err, -o_.max_turn_rate, o_.max_turn_rate);
+  }
+  explore_v_ = v;
+  if (!explore_noted_) {
+    explore_noted_ = true;
+    note(e.stamp, "ambiguous: driving along the corridor to where the look-alike places differ");
+  }
+  return WheelSpeeds{v - w * semi_axis_, v + w * semi_axis_};
+}
+
 bool Executor::start(Stamp stamp, const Pose2& pose,
                      const std::vector<graph::RouteCommand>& commands) {
   if (commands.empty()) {
@@ -134,10 +183,23 @@ WheelSpeeds Executor::step(const fusion::LocalizerEstimate& e) {
   if (!e.known()) {
     if (!lost_since_) {
       lost_since_ = e.stamp;
+      explored_m_ = 0;
+      explore_stamp_.reset();
+      explore_noted_ = false;
       status_ = ExecutorStatus::waiting;
       note(e.stamp, std::string(fusion::to_string(e.mode)) +
                         ": stopped, waiting for relocalization");
-    } else if (to_seconds(e.stamp - *lost_since_) > o_.max_lost_s) {
+    }
+    if (e.mode == fusion::LocalizerMode::ambiguous && e.undecidable) {
+      fail(e.stamp, "the robot cannot tell where it is: " + e.why);
+      return {};
+    }
+    if (e.mode == fusion::LocalizerMode::ambiguous) {
+      if (const auto speeds = explore(e)) return *speeds;
+    } else {
+      explore_stamp_.reset();
+    }
+    if (to_seconds(e.stamp - *lost_since_) > o_.max_lost_s) {
       std::ostringstream why;
       why << "lost for more than " << o_.max_lost_s << " s";
       fail(e.stamp, why.str());

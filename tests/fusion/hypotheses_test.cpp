@@ -152,3 +152,49 @@ TEST(Hypotheses, UnknownStartsOnAGeneratedBuildingOf100Nodes) {
 
 }  // namespace
 }  // namespace lampnav::fusion
+
+namespace lampnav::fusion {
+namespace {
+
+// A perfectly symmetric building: the 3 x 3 grid with every corridor, no rooms. A half turn about
+// its centre maps every lamp onto a lamp alike, so no camera and no motion can tell a place from
+// its twin. The localizer must say so, with the twins, and never pick one.
+TEST(Hypotheses, PerfectlySymmetricBuildingStaysAmbiguousBetweenItsTwins) {
+  sim::BuildingOptions o = grid_office();
+  o.missing_corridors = 0;
+  const Building w(o);
+  test::BatteryOptions bo = traced();
+  bo.max_travel_m = 80;
+  LocalizerOptions lo;
+  std::vector<std::string> whys;
+  std::size_t last_count = 0;
+  bool symmetric_seen = false;
+  bo.trace = [&](double, const Pose2& truth, const Localizer& loc) {
+    const LocalizerEstimate e = loc.estimate();
+    if (e.mode != LocalizerMode::ambiguous) return;
+    last_count = e.hypotheses.size();
+    if (!e.undecidable) return;
+    symmetric_seen = true;
+    // The truth is one of the twins.
+    double nearest = 1e9;
+    for (const auto& h : e.hypotheses)
+      nearest = std::min(nearest, (h.pose.translation() - truth.translation()).norm());
+    EXPECT_LT(nearest, 0.5);
+    whys.push_back(e.why);
+  };
+  test::Battery battery(w.map, w.robot, bo, lo);
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    symmetric_seen = false;
+    const test::EpisodeResult r = battery.unknown_start(seed);
+    EXPECT_FALSE(r.fixed) << "seed " << seed;
+    EXPECT_EQ(r.wrong_fixes, 0);
+    EXPECT_TRUE(symmetric_seen) << "seed " << seed << ": " << r.last_why;
+    EXPECT_EQ(last_count, 2u);
+  }
+  ASSERT_FALSE(whys.empty());
+  std::cout << whys.back() << "\n";
+  EXPECT_NE(whys.back().find("no motion can tell them apart"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace lampnav::fusion

@@ -38,6 +38,7 @@ struct HypothesisSetOptions {
   double publish_ratio = 1000;       // and its likelihood ratio over the runner-up
   int min_omni_frames = 1;           // omni frames that weighed the set before it may publish
   int max_hypotheses = 512;          // an image fitting more places leaves the set incomplete
+  int symmetry_check_max = 8;        // at most this many hypotheses are checked for twins
   double drop_ratio = 1e-9;          // hypotheses below this likelihood ratio to the best die
   double birth_ratio = 1e-4;         // an image gives birth to the places within this ratio of
                                      // its best (the truth's own noise stays far inside it)
@@ -84,6 +85,8 @@ enum class HypothesisVerdict {
   empty,       // no hypothesis: nothing seen yet, or every one was contradicted
   incomplete,  // some hypotheses, but the images fit more places than were enumerated
   ambiguous,   // complete, several hypotheses hold the weight
+  symmetric,   // ambiguous, and the building maps onto itself from one hypothesis to the others
+               // (every lamp onto a lamp alike): no motion and no camera can ever decide
   decided,     // complete, one hypothesis holds it (winner())
 };
 const char* to_string(HypothesisVerdict verdict);

@@ -81,6 +81,8 @@ struct LocalizerEstimate {
   LocalizerMode mode = LocalizerMode::tracking;
   const graph::Node* node = nullptr;  // the node whose region holds the pose, if any
   std::vector<WeightedPose> hypotheses;  // lost or ambiguous: every place it may be, best first
+  bool undecidable = false;  // ambiguous between symmetry twins: no motion can decide
+  std::string why;           // lost or ambiguous: why, in words
   bool known() const { return mode == LocalizerMode::tracking || mode == LocalizerMode::relocalized; }
 };
 

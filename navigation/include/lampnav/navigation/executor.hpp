@@ -4,6 +4,10 @@
 // progress is counted by the places the localizer reports entering. When the robot is lost it
 // stops and waits; once relocalized it plans again from where it now is to the same goal. A
 // command that cannot be carried out, or a robot lost too long, ends the mission with the reason.
+// While the localizer is ambiguous (one of several look-alike places) standing still decides
+// nothing: the executor drives along the corridor the robot stands in, as far as it runs in
+// every one of the places (reachable in all of them), to where their views will differ; between
+// symmetry twins (no motion can decide) it stops and says so.
 
 #include <string>
 #include <vector>
@@ -23,6 +27,8 @@ struct ExecutorOptions {
   double goal_tolerance = 0.15;  // m
   double max_lost_s = 60.0;      // lost longer than this ends the mission
   double off_route_m = 2.0;      // further from the path than this: plan again
+  double explore_m = 40.0;       // while ambiguous, drive at most this far to decide
+  double explore_speed = 0.3;    // m/s
   void validate() const;         // throws InputError naming the field
 };
 
@@ -62,6 +68,9 @@ class Executor {
   bool replan(Stamp stamp, const Pose2& pose, const std::string& why);
   void fail(Stamp stamp, const std::string& why);
   void note(Stamp stamp, const std::string& text) { events_.push_back({stamp, text}); }
+  // Wheel speeds that take the robot along its corridor to where the look-alike places differ,
+  // or nothing when no such motion is known.
+  std::optional<WheelSpeeds> explore(const fusion::LocalizerEstimate& e);
 
   const graph::TopologicalMap* map_;
   double semi_axis_;
@@ -73,6 +82,10 @@ class Executor {
   std::size_t reached_ = 0;  // index in plan_.route.nodes of the last place entered
   const graph::Node* last_node_ = nullptr;
   std::optional<Stamp> lost_since_;
+  double explored_m_ = 0;              // driven while ambiguous since the loss
+  std::optional<Stamp> explore_stamp_;  // the last exploring step
+  double explore_v_ = 0;
+  bool explore_noted_ = false;
   std::vector<ExecutorEvent> events_;
   int replans_ = 0;
 };
