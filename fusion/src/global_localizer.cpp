@@ -87,7 +87,7 @@ GlobalLocalizer::Impl::Impl(const graph::TopologicalMap& m, const CameraDescript
 void GlobalLocalizer::Impl::index_lamps() {
   const LampPairOptions& q = o.pairs;
   std::map<std::pair<long, long>, int> class_ids;
-  double max_height = 0;
+  max_height = 0;
   for (std::size_t i = 0; i < lamps.size(); ++i) {
     lamp_index[lamps[i]] = static_cast<int>(i);
     const double h = lamps[i]->xyz.z() - mount_t.z();
@@ -129,14 +129,14 @@ void GlobalLocalizer::Impl::index_lamps() {
   view_radius = max_height * std::tan(theta) + offset + longest + 1.0;
 }
 
-std::vector<int> GlobalLocalizer::Impl::lamps_in_view(const Pose2& pose) const {
+std::vector<int> GlobalLocalizer::Impl::lamps_in_view(const Pose2& pose, double radius) const {
   std::vector<int> out;
-  if (lamps.size() <= 256) {
+  if (lamps.size() <= 256 && radius <= 0) {
     out.resize(lamps.size());
     for (std::size_t i = 0; i < lamps.size(); ++i) out[i] = static_cast<int>(i);
     return out;
   }
-  for (const graph::Lamp* l : map->lamps_within(pose.translation(), view_radius))
+  for (const graph::Lamp* l : map->lamps_within(pose.translation(), radius > 0 ? radius : view_radius))
     out.push_back(lamp_index.at(l));
   std::sort(out.begin(), out.end());  // the map's order, so that results do not depend on the index
   return out;
@@ -167,9 +167,15 @@ double GlobalLocalizer::Impl::blob_half_size(const graph::Lamp& l, double range)
 
 GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     const Pose2& pose, const Tilt& tilt, double position_sigma, double yaw_sigma, double tilt_sigma,
-    const std::vector<BlobRay>& blobs) const {
+    const std::vector<BlobRay>& blobs, double screen_theta) const {
   const LampPairOptions& q = o.pairs;
-  const double max_theta = q.max_theta_deg * kDeg, expect_theta = q.expect_max_theta_deg * kDeg;
+  const double max_theta = screen_theta > 0 ? screen_theta : q.max_theta_deg * kDeg;
+  const double expect_theta =
+      screen_theta > 0 ? screen_theta : q.expect_max_theta_deg * kDeg;
+  const double radius =
+      screen_theta > 0
+          ? max_height * std::tan(std::min(screen_theta, 89.0 * kDeg)) + mount_t.head<2>().norm() + 3.0
+          : 0.0;
   const double det = q.detection_sigma_deg * kDeg;
   const double cos_limit = std::cos(std::min(M_PI, max_theta + 0.1));
   struct Predicted {
@@ -179,7 +185,7 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     bool crowded = false, matched = false;
   };
   std::vector<Predicted> pred;
-  for (const int i : lamps_in_view(pose)) {
+  for (const int i : lamps_in_view(pose, radius)) {
     const Vector3d c = camera_point(pose, lamps[i]->xyz, tilt);
     const double range = c.norm();
     if (!(range > 0.1)) continue;

@@ -109,8 +109,10 @@ struct GlobalLocalizer::Impl {
   // maps; on small ones all of them.
   std::unordered_map<const graph::Lamp*, int> lamp_index;
   double view_radius = 0;
+  double max_height = 0;  // of a lamp above the camera
   void index_lamps();
-  std::vector<int> lamps_in_view(const Pose2& pose) const;
+  // The lamps within `radius` of the pose (default: view_radius).
+  std::vector<int> lamps_in_view(const Pose2& pose, double radius = 0) const;
 
   Impl(const graph::TopologicalMap& m, const CameraDescription& camera,
        const GlobalLocalizerOptions& opt);
@@ -132,8 +134,11 @@ struct GlobalLocalizer::Impl {
 
   // Scores a pose known within (position_sigma, yaw_sigma) and a floor tilt known within
   // tilt_sigma: predicted lamps matched one-to-one to blobs, nearest first, within 3 sigma.
+  // With `screen_theta` (rad) only lamps within it of the axis are predicted and expected: a
+  // cheaper screening of many candidates with the blobs of that cone.
   Evaluation evaluate(const Pose2& pose, const Tilt& tilt, double position_sigma, double yaw_sigma,
-                      double tilt_sigma, const std::vector<BlobRay>& blobs) const;
+                      double tilt_sigma, const std::vector<BlobRay>& blobs,
+                      double screen_theta = 0) const;
 
   struct Solution {
     Pose2 pose;

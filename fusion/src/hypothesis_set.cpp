@@ -169,8 +169,9 @@ struct HypothesisSet::Impl {
     return c;
   }
 
-  // Kalman update of a hypothesis with a pose measurement; returns -2 ln N(z; x, S) less the
-  // constant.
+  // Kalman update of a hypothesis with a pose measurement; returns the normalized innovation
+  // squared less its expectation (3): what the measurement says against the prediction, about 0
+  // for a right hypothesis, comparable between hypotheses whatever their covariance.
   double update(Hypothesis& h, const Pose2& z, const Eigen::Matrix3d& R) const {
     const Eigen::Matrix3d S = h.covariance + R;
     Eigen::Vector3d nu(z.x() - h.pose.x(), z.y() - h.pose.y(), wrap_angle(z.yaw() - h.pose.yaw()));
@@ -186,7 +187,7 @@ struct HypothesisSet::Impl {
     if (h.covariance(0, 0) < fp) h.covariance(0, 0) = fp;
     if (h.covariance(1, 1) < fp) h.covariance(1, 1) = fp;
     if (h.covariance(2, 2) < fy) h.covariance(2, 2) = fy;
-    return nu.dot(Si * nu) + std::log(std::max(1e-300, S.determinant()));
+    return nu.dot(Si * nu) - 3.0;
   }
 
   static double sigma_position(const Eigen::Matrix3d& P) {
@@ -251,9 +252,7 @@ struct HypothesisSet::Impl {
       const std::optional<PoseMeasurement> m =
           measure_pose(*geometry, camera->parameters().fx, labelled, h.pose, Stamp{}, measurement,
                        nullptr, &refusal);
-      if (m)
-        cost += update(h, m->pose, m->covariance) -
-                std::log(std::max(1e-300, m->covariance.determinant()));
+      if (m) cost += update(h, m->pose, m->covariance);
       else if (refusal == PoseRefusal::labels_disagree)
         cost += o.ceiling_spurious_cost;
     }

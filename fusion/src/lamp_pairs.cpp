@@ -224,6 +224,10 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
           cells.emplace(cell_key, Pose2(p, yaw));
         }
       }
+  const double screen = q.pair_max_theta_deg * kDeg;
+  std::vector<BlobRay> near;
+  for (const BlobRay& b : blobs)
+    if (b.theta <= screen) near.push_back(b);
   // In the graph, and the other seeds on lamps (all but one of them).
   std::vector<std::pair<std::int64_t, Pose2>> poses(cells.begin(), cells.end());
   std::sort(poses.begin(), poses.end(),
@@ -246,8 +250,9 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
       if (!on_lamp) ++misses;
     }
     if (misses > 1) continue;
-    scored.emplace_back(evaluate(pose, {}, 0.3, 3 * kDeg, q.tilt_sigma_deg * kDeg, blobs).cost,
-                        pose);
+    // Screened on the cone of the seeds (a few lamps each), the survivors scored in full.
+    scored.emplace_back(
+        evaluate(pose, {}, 0.3, 3 * kDeg, q.tilt_sigma_deg * kDeg, near, screen).cost, pose);
   }
   out.merit_evaluations = static_cast<int>(scored.size());
   if (scored.empty()) {
@@ -257,9 +262,9 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   }
   std::stable_sort(scored.begin(), scored.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
-  // Refined: the coarse scores within reach of the best (a coarse pose is up to a cell off),
-  // at most four times the cap; then every refined pose within `margin` of the best must fit
-  // under the cap for the search to be complete.
+  // Refined: the screening scores within reach of the best (a coarse pose is up to a cell off,
+  // and the screen sees only part of the view), at most four times the cap; then every refined
+  // pose within `margin` of the best must fit under the cap for the search to be complete.
   const double reach = scored.front().first + margin + 30.0;
   const std::size_t limit = 4 * std::size_t(cap);
   std::vector<PoseHypothesis> refined;

@@ -177,18 +177,27 @@ struct Battery::Impl {
       }
       std::stable_sort(pending.begin(), pending.end(),
                        [](const Pending& a, const Pending& c) { return a.at < c.at; });
-      const auto t0 = std::chrono::steady_clock::now();
       while (!pending.empty() && pending.front().at <= t) {
         const Pending& p = pending.front();
+        const bool was_unsure = !known(loc.mode());
+        const std::size_t live = loc.hypotheses().hypotheses().size();
+        const auto t0 = std::chrono::steady_clock::now();
         if (p.ceiling)
           loc.ceiling_detections(stamp(p.capture), p.lamps);
         else
           loc.omni_detection(stamp(p.capture), p.omni);
+        const double took =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        r.localizer_s += took;
+        if (was_unsure) {
+          r.unsure_s += took;
+          ++r.unsure_frames;
+          r.unsure_hypotheses += live;
+        }
         if (o.trace) o.trace(t, truth, loc);
         ++r.frames;
         pending.pop_front();
       }
-      r.localizer_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       // Score what it publishes now.
       const fusion::LocalizerEstimate e = loc.estimate();
       const bool after = !kidnap_at_m || kidnapped_at;
@@ -256,6 +265,42 @@ EpisodeResult Battery::unknown_start(std::uint64_t seed) {
 
 EpisodeResult Battery::unknown_start_at(const Pose2& start, std::uint64_t seed) {
   return impl_->run(start, std::nullopt, seed);
+}
+
+BatteryFigures figures(const std::vector<EpisodeResult>& rs) {
+  BatteryFigures f;
+  std::vector<double> lat_s, lat_m;
+  double unsure_s = 0;
+  std::size_t unsure_frames = 0, unsure_hyp = 0;
+  for (const auto& r : rs) {
+    ++f.episodes;
+    f.detected += r.detected;
+    f.fixed += r.fixed;
+    f.correct += r.fix_correct;
+    f.wrong_fixes += r.wrong_fixes;
+    f.max_hypotheses = std::max(f.max_hypotheses, r.max_hypotheses);
+    unsure_s += r.unsure_s;
+    unsure_frames += r.unsure_frames;
+    unsure_hyp += r.unsure_hypotheses;
+    if (r.fixed) {
+      lat_s.push_back(r.latency_s);
+      lat_m.push_back(r.latency_m);
+    }
+  }
+  auto pct = [](std::vector<double> v, double q) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    return v[std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5))];
+  };
+  f.latency_s_median = pct(lat_s, 0.5);
+  f.latency_s_p95 = pct(lat_s, 0.95);
+  f.latency_m_median = pct(lat_m, 0.5);
+  f.latency_m_p95 = pct(lat_m, 0.95);
+  if (unsure_frames) {
+    f.unsure_us_per_frame = 1e6 * unsure_s / unsure_frames;
+    f.unsure_mean_hypotheses = double(unsure_hyp) / unsure_frames;
+  }
+  return f;
 }
 
 std::string summarize(const std::vector<EpisodeResult>& rs) {

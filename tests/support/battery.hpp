@@ -34,6 +34,10 @@ struct EpisodeResult {
   double ambiguous_s = 0, lost_s = 0;
   double localizer_s = 0;  // wall time in the localizer
   std::size_t frames = 0;  // camera frames given to it
+  // Of those, while it did not know (lost or ambiguous): the time they took and the live
+  // hypotheses they weighed (summed over the frames).
+  double unsure_s = 0;
+  std::size_t unsure_frames = 0, unsure_hypotheses = 0;
   std::string last_why;    // the localizer's last word when it never fixed
 };
 
@@ -71,5 +75,14 @@ class Battery {
 };
 
 std::string summarize(const std::vector<EpisodeResult>& results);
+
+// The figures of a battery: counts, and latency percentiles over the episodes that fixed.
+struct BatteryFigures {
+  int episodes = 0, detected = 0, fixed = 0, correct = 0, wrong_fixes = 0;
+  double latency_s_median = 0, latency_s_p95 = 0, latency_m_median = 0, latency_m_p95 = 0;
+  std::size_t max_hypotheses = 0;
+  double unsure_us_per_frame = 0, unsure_mean_hypotheses = 0;
+};
+BatteryFigures figures(const std::vector<EpisodeResult>& results);
 
 }  // namespace lampnav::test

@@ -42,8 +42,9 @@ struct HypothesisSetOptions {
   double drop_ratio = 1e-9;          // hypotheses below this likelihood ratio to the best die
   double birth_ratio = 1e-4;         // an image gives birth to the places within this ratio of
                                      // its best (the truth's own noise stays far inside it)
-  int refined = 64;                  // the likeliest, refined by least squares on each omni
-                                     // frame; the others are only scored (cheap)
+  int refined = 1024;                // the likeliest, refined by least squares on each omni
+                                     // frame; the others are only scored (cheaper, but their
+                                     // costs are then less comparable)
   double frame_cost_cap = 12.0;      // -2 ln L one omni frame can cost a hypothesis: one odd
                                      // frame (a person under a lamp) never decides alone
   double ceiling_cost_cap = 2.0;     // the same for a ceiling frame: ten a second see the same

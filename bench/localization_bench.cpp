@@ -1,0 +1,93 @@
+// Multi-hypothesis localization on generated buildings with the asymmetries real ones have
+// (rooms, a missing corridor, a wing with another lamp spacing, a lobby), by the battery of the
+// tests (tests/support/battery.hpp: driven tours, noisy odometry, ideal detections of both
+// cameras delivered late):
+//  - 100 kidnaps per building size (dropped anywhere in a corridor, any heading): detected,
+//    relocalized to the true place, wrong fixes (target: 100, 100, 0), latency in s and m;
+//  - unknown starts: wrong fixes (target 0), latency;
+//  - the localizer's time per camera frame while it does not know, with the live hypotheses
+//    it weighs (target: 2 ms a frame with 100 hypotheses).
+// Each runs once (Iterations(1)); the figures are counters.
+
+#include <benchmark/benchmark.h>
+
+#include <string>
+
+#include "battery.hpp"
+#include "lampnav/graph/geojson.hpp"
+#include "lampnav/sim/building.hpp"
+
+namespace lampnav {
+namespace {
+
+struct World {
+  graph::TopologicalMap map;
+  RobotDescription robot;
+  explicit World(int nodes) {
+    sim::BuildingOptions o;
+    o.nodes = nodes;
+    o.missing_corridors = 1;
+    o.wing_lamp_spacing_m = 2.7;
+    o.lobby = true;
+    o.seed = 5;
+    map = graph::parse_map(sim::generate_building(o).geojson, "generated").map;
+    robot = read_robot_description(std::string(LAMPNAV_SOURCE_DIR) + "/maps/robots/pioneer.json");
+  }
+};
+
+void report(benchmark::State& state, const test::BatteryFigures& f) {
+  state.counters["episodes"] = f.episodes;
+  state.counters["detected"] = f.detected;
+  state.counters["correct"] = f.correct;
+  state.counters["wrong_fixes"] = f.wrong_fixes;
+  state.counters["latency_s_median"] = f.latency_s_median;
+  state.counters["latency_s_p95"] = f.latency_s_p95;
+  state.counters["latency_m_median"] = f.latency_m_median;
+  state.counters["latency_m_p95"] = f.latency_m_p95;
+  state.counters["max_hypotheses"] = static_cast<double>(f.max_hypotheses);
+  state.counters["unsure_us_per_frame"] = f.unsure_us_per_frame;
+  state.counters["unsure_mean_hypotheses"] = f.unsure_mean_hypotheses;
+}
+
+void BM_KidnapBattery(benchmark::State& state) {
+  const World w(static_cast<int>(state.range(0)));
+  test::BatteryFigures f;
+  for (auto _ : state) {
+    test::Battery battery(w.map, w.robot);
+    std::vector<test::EpisodeResult> rs;
+    for (int k = 1; k <= state.range(1); ++k) rs.push_back(battery.kidnap(5000 + k));
+    f = test::figures(rs);
+  }
+  report(state, f);
+}
+BENCHMARK(BM_KidnapBattery)
+    ->Args({10, 100})
+    ->Args({100, 100})
+    ->Args({1000, 100})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+
+void BM_UnknownStartBattery(benchmark::State& state) {
+  const World w(static_cast<int>(state.range(0)));
+  test::BatteryFigures f;
+  for (auto _ : state) {
+    test::Battery battery(w.map, w.robot);
+    std::vector<test::EpisodeResult> rs;
+    for (int k = 1; k <= state.range(1); ++k) rs.push_back(battery.unknown_start(7000 + k));
+    f = test::figures(rs);
+  }
+  report(state, f);
+}
+BENCHMARK(BM_UnknownStartBattery)
+    ->Args({10, 20})
+    ->Args({100, 20})
+    ->Args({1000, 20})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+
+}  // namespace
+}  // namespace lampnav
+
+BENCHMARK_MAIN();
