@@ -132,6 +132,45 @@ void add_counter(const std::string& what, const std::string& bench, const std::s
   out_rows.push_back(j);
 }
 
+// A localization battery (bench/localization_bench.cpp): every episode relocalized to the true
+// place (kidnaps: detected too) and not one wrong fix; the latency beside it.
+void add_battery(const std::string& what, const std::string& bench, bool kidnaps) {
+  Row r{what, "not run", "", "", kidnaps ? "all detected, all right, 0 wrong" : "all right, 0 wrong",
+        "MISSED"};
+  Json j{{"case", what}};
+  auto it = results.find(bench);
+  if (it != results.end() && it->second.raw.contains("episodes")) {
+    const Json& c = it->second.raw;
+    const int n = c["episodes"].get<double>(), d = c["detected"].get<double>(),
+              ok = c["correct"].get<double>(), wrong = c["wrong_fixes"].get<double>();
+    std::ostringstream s;
+    s << std::setprecision(3);
+    if (kidnaps) s << d << "/" << n << " detected, ";
+    s << ok << "/" << n << " right, " << wrong << " wrong; latency p50 "
+      << c["latency_s_median"].get<double>() << " s / " << c["latency_m_median"].get<double>()
+      << " m, p95 " << c["latency_s_p95"].get<double>() << " s / "
+      << c["latency_m_p95"].get<double>() << " m";
+    r.ours = s.str();
+    const bool met = ok == n && wrong == 0 && (!kidnaps || d == n);
+    r.verdict = met ? "met" : "MISSED";
+    j["ours"] = c;
+    j["met"] = met;
+  } else {
+    j["met"] = false;
+  }
+  rows.push_back(r);
+  out_rows.push_back(j);
+  // The localizer's time per camera frame while unsure, with the hypotheses it weighed.
+  if (it != results.end() && it->second.raw.contains("unsure_us_per_frame")) {
+    const Json& c = it->second.raw;
+    std::ostringstream name;
+    name << std::setprecision(3) << "  localizer per frame while unsure ("
+         << c["unsure_mean_hypotheses"].get<double>() << " hypotheses on average)";
+    add(name.str(), c["unsure_us_per_frame"].get<double>(), "", std::nullopt, 2000.0,
+        std::nullopt);
+  }
+}
+
 // How a cost grows with the building: the exponent of n between 100 and 1,000 nodes.
 Json growth = Json::object();
 void grows(const std::string& what, const std::string& bench) {
@@ -206,6 +245,12 @@ int main(int argc, char** argv) {
     add_counter(std::string("replay of a 10-minute mission, ") + n + "-node building",
                 std::string("BM_ReplayBuildingMission/") + n, "realtime_factor", 50, "x real time");
   grows("replay", "BM_ReplayBuildingMission");
+  for (const auto& [n, count] : {std::pair{"10", "100"}, {"100", "100"}, {"1000", "1"}})
+    add_battery(std::string("kidnaps (") + count + "), " + n + "-node building",
+                std::string("BM_KidnapBattery/") + n + "/" + count, true);
+  for (const auto& [n, count] : {std::pair{"10", "20"}, {"100", "20"}, {"1000", "1"}})
+    add_battery(std::string("unknown starts (") + count + "), " + n + "-node building",
+                std::string("BM_UnknownStartBattery/") + n + "/" + count, false);
 
   std::size_t w[5] = {4, 4, 4, 5, 6};
   for (const auto& r : rows) {

@@ -315,7 +315,8 @@ GlobalLocalizer::Impl::Solution GlobalLocalizer::Impl::solve(Pose2 pose, Tilt ti
 }
 
 PoseHypothesis GlobalLocalizer::Impl::refine(Pose2 pose, double position_sigma, double yaw_sigma,
-                                             const std::vector<BlobRay>& blobs) const {
+                                             const std::vector<BlobRay>& blobs, int rounds,
+                                             bool with_tilt) const {
   const double tilt_sigma = o.pairs.tilt_sigma_deg * kDeg;
   Tilt tilt;
   Evaluation e = evaluate(pose, tilt, position_sigma, yaw_sigma, tilt_sigma, blobs);
@@ -323,11 +324,11 @@ PoseHypothesis GlobalLocalizer::Impl::refine(Pose2 pose, double position_sigma, 
                           yaw_sigma * yaw_sigma)
                      .asDiagonal();
   double ts = tilt_sigma;
-  for (int round = 0; round < 3 && e.matches.size() >= 2; ++round) {
+  for (int round = 0; round < rounds && e.matches.size() >= 2; ++round) {
     // The tilt is estimated only when it explains the directions clearly better (by more
     // than chi-square's 95 % point for its two degrees of freedom) than a level floor.
     const Solution level = solve(pose, tilt, e, blobs, false);
-    const Solution tilted = tilt_sigma > 0 ? solve(pose, tilt, e, blobs, true) : level;
+    const Solution tilted = with_tilt && tilt_sigma > 0 ? solve(pose, tilt, e, blobs, true) : level;
     const Solution& sol = tilted.cost + 6.0 < level.cost ? tilted : level;
     pose = sol.pose;
     tilt = sol.tilt;

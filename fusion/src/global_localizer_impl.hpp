@@ -157,8 +157,11 @@ struct GlobalLocalizer::Impl {
                  bool with_tilt) const;
 
   // Refines a pose: match, solve, match again with the tolerance the solution earned.
+  // `rounds` of match-and-solve; `with_tilt`: the floor's tilt considered (a level floor is
+  // three times cheaper, enough to tell a candidate from the rest).
   PoseHypothesis refine(Pose2 pose, double position_sigma, double yaw_sigma,
-                        const std::vector<BlobRay>& blobs) const;
+                        const std::vector<BlobRay>& blobs, int rounds = 3,
+                        bool with_tilt = true) const;
 
   // The paper's merit of a pose, for every hypothesis whatever its method.
   double paper_merit(const Pose2& pose, const MeritFunction& merit) const;

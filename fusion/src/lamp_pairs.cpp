@@ -272,7 +272,8 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   for (const auto& [cost, pose] : scored) {
     if (cost > reach) break;
     if (++within > limit) break;
-    PoseHypothesis h = refine(pose, 0.3, 3 * kDeg, blobs);
+    // One level round: enough to rank the candidates; the hypothesis set refines in full.
+    PoseHypothesis h = refine(pose, 0.3, 3 * kDeg, blobs, 1, false);
     if (q.restrict_to_graph && has_regions && !node_of(h.pose)) continue;
     refined.push_back(std::move(h));
   }
