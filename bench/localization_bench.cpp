@@ -24,13 +24,9 @@ struct World {
   graph::TopologicalMap map;
   RobotDescription robot;
   explicit World(int nodes) {
-    sim::BuildingOptions o;
-    o.nodes = nodes;
-    o.missing_corridors = 1;
-    o.wing_lamp_spacing_m = 2.7;
-    o.lobby = true;
-    o.seed = 5;
-    map = graph::parse_map(sim::generate_building(o).geojson, "generated").map;
+    map = graph::parse_map(sim::generate_building(test::asymmetric_building(nodes)).geojson,
+                           "generated")
+              .map;
     robot = read_robot_description(std::string(LAMPNAV_SOURCE_DIR) + "/maps/robots/pioneer.json");
   }
 };
@@ -49,16 +45,22 @@ void report(benchmark::State& state, const test::BatteryFigures& f) {
   state.counters["unsure_mean_hypotheses"] = f.unsure_mean_hypotheses;
 }
 
-void BM_KidnapBattery(benchmark::State& state) {
+// range(0) nodes, range(1) episodes, each `episode(battery, seed)`.
+template <class Episode>
+void run_battery(benchmark::State& state, std::uint64_t first_seed, Episode episode) {
   const World w(static_cast<int>(state.range(0)));
   test::BatteryFigures f;
   for (auto _ : state) {
     test::Battery battery(w.map, w.robot);
     std::vector<test::EpisodeResult> rs;
-    for (int k = 1; k <= state.range(1); ++k) rs.push_back(battery.kidnap(5000 + k));
+    for (int k = 1; k <= state.range(1); ++k) rs.push_back(episode(battery, first_seed + k));
     f = test::figures(rs);
   }
   report(state, f);
+}
+
+void BM_KidnapBattery(benchmark::State& state) {
+  run_battery(state, 5000, [](test::Battery& b, std::uint64_t seed) { return b.kidnap(seed); });
 }
 BENCHMARK(BM_KidnapBattery)
     ->Args({10, 100})
@@ -69,15 +71,8 @@ BENCHMARK(BM_KidnapBattery)
     ->UseRealTime();
 
 void BM_UnknownStartBattery(benchmark::State& state) {
-  const World w(static_cast<int>(state.range(0)));
-  test::BatteryFigures f;
-  for (auto _ : state) {
-    test::Battery battery(w.map, w.robot);
-    std::vector<test::EpisodeResult> rs;
-    for (int k = 1; k <= state.range(1); ++k) rs.push_back(battery.unknown_start(7000 + k));
-    f = test::figures(rs);
-  }
-  report(state, f);
+  run_battery(state, 7000,
+              [](test::Battery& b, std::uint64_t seed) { return b.unknown_start(seed); });
 }
 BENCHMARK(BM_UnknownStartBattery)
     ->Args({10, 20})

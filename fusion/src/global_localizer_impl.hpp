@@ -170,6 +170,20 @@ struct GlobalLocalizer::Impl {
 
   // ---------------------------------------------------------------------------------------
   // Method `default`.
+
+  // The blobs nearest the optical axis (at most `max`), and where each puts a lamp of each
+  // class in the base frame, were it one, with the sigma of that place (-1: says nothing).
+  struct Seeds {
+    std::vector<BlobRay> rays;
+    std::vector<Eigen::Vector2d> at;  // [seed * classes + class]
+    std::vector<double> sigma;
+    std::size_t size() const { return rays.size(); }
+  };
+  Seeds seeds_of(const std::vector<BlobRay>& blobs, const LampPairOptions& q, std::size_t max) const;
+  // Each pose that puts seeds j and k on a pair of map lamps spaced like them (both classes'
+  // index looked up by spacing): fn(pose).
+  template <class Fn>
+  void pair_poses(const Seeds& s, std::size_t j, std::size_t k, Fn fn) const;
   // With `q` and `max_hypotheses` (the options', or enumerate()'s larger caps).
   GlobalLocalization lamp_pairs(const vision::OmniDetection& d, const LampPairOptions& q,
                                 int max_hypotheses) const;

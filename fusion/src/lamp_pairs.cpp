@@ -12,6 +12,76 @@ namespace lampnav::fusion {
 
 using namespace detail;
 
+GlobalLocalizer::Impl::Seeds GlobalLocalizer::Impl::seeds_of(const std::vector<BlobRay>& blobs,
+                                                             const LampPairOptions& q,
+                                                             std::size_t max) const {
+  Seeds s;
+  // Nearest the optical axis, where a ray says most about position.
+  for (const BlobRay& b : blobs)
+    if (b.theta <= q.pair_max_theta_deg * kDeg && (mount_R * b.ray).z() > 0.05)
+      s.rays.push_back(b);
+  std::sort(s.rays.begin(), s.rays.end(),
+            [](const BlobRay& a, const BlobRay& b) { return a.theta < b.theta; });
+  if (s.rays.size() > max) s.rays.resize(max);
+  const double sa = std::hypot(q.detection_sigma_deg, q.tilt_sigma_deg) * kDeg;
+  const std::size_t nc = classes.size(), ns = s.rays.size();
+  s.at.resize(ns * nc);
+  s.sigma.assign(ns * nc, -1);
+  for (std::size_t j = 0; j < ns; ++j) {
+    const Vector3d rb = mount_R * s.rays[j].ray;
+    for (std::size_t c = 0; c < nc; ++c) {
+      const double h = classes[c].height;
+      if (h < 0.2) continue;
+      s.at[j * nc + c] = mount_t.head<2>() + (h / rb.z()) * rb.head<2>();
+      const double sj = h * sa / (rb.z() * rb.z()) + 0.1 * classes[c].length;
+      // A seed that puts the lamp no better than this says nothing of the pose.
+      if (sj <= 0.5) s.sigma[j * nc + c] = sj;
+    }
+  }
+  return s;
+}
+
+template <class Fn>
+void GlobalLocalizer::Impl::pair_poses(const Seeds& s, std::size_t j, std::size_t k, Fn fn) const {
+  const std::size_t nc = classes.size();
+  for (const auto& [key, group] : pair_groups) {
+    const double sj = s.sigma[j * nc + key.first], sk = s.sigma[k * nc + key.second];
+    if (sj < 0 || sk < 0) continue;
+    const Vector2d& qi = s.at[j * nc + key.first];
+    const Vector2d& ql = s.at[k * nc + key.second];
+    const Vector2d dq = ql - qi;
+    const double dn = dq.norm(), dq_angle = std::atan2(dq.y(), dq.x());
+    const double tol = 3 * std::hypot(sj, sk) + 0.02;
+    auto lo = std::lower_bound(group.begin(), group.end(), dn - tol,
+                               [](const LampPair& p, double v) { return p.distance < v; });
+    for (auto it = lo; it != group.end() && it->distance <= dn + tol; ++it) {
+      const graph::Lamp& La = *lamps[it->a];
+      const graph::Lamp& Lb = *lamps[it->b];
+      const Vector2d Li(La.xyz.x(), La.xyz.y()), Ll(Lb.xyz.x(), Lb.xyz.y());
+      const double yaw = wrap_angle(it->angle - dq_angle);
+      const double c = std::cos(yaw), si = std::sin(yaw);
+      const Vector2d mid_q = 0.5 * (qi + ql), mid_L = 0.5 * (Li + Ll);
+      fn(Pose2(mid_L - Vector2d(c * mid_q.x() - si * mid_q.y(), si * mid_q.x() + c * mid_q.y()),
+               yaw));
+    }
+  }
+}
+
+namespace {
+// The voting cell of a pose: 0.25 m x 3 degrees.
+std::int64_t cell_of(const Pose2& p) {
+  const double cell_m = 0.25, cell_rad = 3 * kDeg;
+  return (std::int64_t(std::floor(p.x() / cell_m)) * 1000003 +
+          std::int64_t(std::floor(p.y() / cell_m))) *
+             1009 +
+         std::int64_t(std::floor((p.yaw() + M_PI) / cell_rad));
+}
+std::string too_few_seeds(std::size_t n, const LampPairOptions& q) {
+  return std::to_string(n) + " lamp(s) within " + std::to_string(int(q.pair_max_theta_deg)) +
+         " degrees of the optical axis: a pose needs two";
+}
+}  // namespace
+
 GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection& d,
                                                      const LampPairOptions& q,
                                                      int max_hypotheses) const {
@@ -19,34 +89,11 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
   out.method = GlobalMethod::lamp_pairs;
   const std::vector<BlobRay> blobs = blob_rays(d, q.max_theta_deg * kDeg);
   out.blobs = static_cast<int>(blobs.size());
-  // Detections for pairs: nearest the optical axis, where a ray says most about position.
-  std::vector<BlobRay> seeds;
-  for (const BlobRay& b : blobs)
-    if (b.theta <= q.pair_max_theta_deg * kDeg && (mount_R * b.ray).z() > 0.05) seeds.push_back(b);
-  std::sort(seeds.begin(), seeds.end(),
-            [](const BlobRay& a, const BlobRay& b) { return a.theta < b.theta; });
-  if (seeds.size() > std::size_t(q.pair_max_blobs)) seeds.resize(q.pair_max_blobs);
-  if (seeds.size() < 2) {
-    out.why = std::to_string(seeds.size()) + " lamp(s) within " +
-              std::to_string(int(q.pair_max_theta_deg)) +
-              " degrees of the optical axis: a pose needs two";
+  const Seeds seeds = seeds_of(blobs, q, std::size_t(q.pair_max_blobs));
+  const std::size_t ns = seeds.size();
+  if (ns < 2) {
+    out.why = too_few_seeds(ns, q);
     return out;
-  }
-  // Where each seed puts a lamp of each class, in the base frame, were it one.
-  const double sa = std::hypot(q.detection_sigma_deg, q.tilt_sigma_deg) * kDeg;
-  const std::size_t nc = classes.size(), ns = seeds.size();
-  std::vector<Vector2d> at(ns * nc);
-  std::vector<double> sigma(ns * nc, -1);
-  for (std::size_t j = 0; j < ns; ++j) {
-    const Vector3d rb = mount_R * seeds[j].ray;
-    for (std::size_t c = 0; c < nc; ++c) {
-      const double h = classes[c].height;
-      if (h < 0.2) continue;
-      at[j * nc + c] = mount_t.head<2>() + (h / rb.z()) * rb.head<2>();
-      const double sj = h * sa / (rb.z() * rb.z()) + 0.1 * classes[c].length;
-      // A seed that puts the lamp no better than this says nothing of the pose.
-      if (sj <= 0.5) sigma[j * nc + c] = sj;
-    }
   }
   // Vote: every pair of seeds matched to a pair of lamps at the same spacing is a pose. The
   // lamp pairs come from the index, looked up by spacing.
@@ -56,40 +103,16 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
   };
   std::unordered_map<std::int64_t, Cell> cells;
   cells.reserve(4096);
-  const double cell_m = 0.25, cell_rad = 3 * kDeg;
   for (std::size_t j = 0; j < ns; ++j)
     for (std::size_t k = j + 1; k < ns; ++k)
-      for (const auto& [key, group] : pair_groups) {
-        const double sj = sigma[j * nc + key.first], sk = sigma[k * nc + key.second];
-        if (sj < 0 || sk < 0) continue;
-        const Vector2d& qi = at[j * nc + key.first];
-        const Vector2d& ql = at[k * nc + key.second];
-        const Vector2d dq = ql - qi;
-        const double dn = dq.norm();
-        const double dq_angle = std::atan2(dq.y(), dq.x());
-        const double tol = 3 * std::hypot(sj, sk) + 0.02;
-        auto lo = std::lower_bound(group.begin(), group.end(), dn - tol,
-                                   [](const LampPair& p, double v) { return p.distance < v; });
-        for (auto it = lo; it != group.end() && it->distance <= dn + tol; ++it) {
-          const Vector2d Li = lamps[it->a]->xyz.head<2>(), Ll = lamps[it->b]->xyz.head<2>();
-          const double yaw = wrap_angle(it->angle - dq_angle);
-          const double c = std::cos(yaw), s = std::sin(yaw);
-          const Vector2d mid_q = 0.5 * (qi + ql);
-          const Vector2d mid_L = 0.5 * (Li + Ll);
-          const Vector2d p =
-              mid_L - Vector2d(c * mid_q.x() - s * mid_q.y(), s * mid_q.x() + c * mid_q.y());
-          const std::int64_t cell_key = (std::int64_t(std::floor(p.x() / cell_m)) * 1000003 +
-                                         std::int64_t(std::floor(p.y() / cell_m))) *
-                                            1009 +
-                                        std::int64_t(std::floor((yaw + M_PI) / cell_rad));
-          Cell& cell = cells[cell_key];
-          ++cell.votes;
-          cell.x += p.x();
-          cell.y += p.y();
-          cell.c += c;
-          cell.s += s;
-        }
-      }
+      pair_poses(seeds, j, k, [&](const Pose2& p) {
+        Cell& cell = cells[cell_of(p)];
+        ++cell.votes;
+        cell.x += p.x();
+        cell.y += p.y();
+        cell.c += std::cos(p.yaw());
+        cell.s += std::sin(p.yaw());
+      });
   // The most voted cells, best first (ties by key, so that the result never depends on the hash
   // map's order); only the few that can be scored are sorted.
   std::vector<std::pair<int, std::int64_t>> ranked;
@@ -151,11 +174,6 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
   return out;
 }
 
-}  // namespace lampnav::fusion
-
-namespace lampnav::fusion {
-
-using namespace detail;
 
 // Every pose that puts a map lamp under each of two blobs near the optical axis: the pair of
 // blobs matched to every pair of map lamps spaced like them (both ways round), for the three
@@ -169,61 +187,18 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   out.method = GlobalMethod::lamp_pairs;
   const std::vector<BlobRay> blobs = blob_rays(d, q.max_theta_deg * kDeg);
   out.blobs = static_cast<int>(blobs.size());
-  std::vector<BlobRay> seeds;
-  for (const BlobRay& b : blobs)
-    if (b.theta <= q.pair_max_theta_deg * kDeg && (mount_R * b.ray).z() > 0.05) seeds.push_back(b);
-  std::sort(seeds.begin(), seeds.end(),
-            [](const BlobRay& a, const BlobRay& b) { return a.theta < b.theta; });
-  if (seeds.size() > 6) seeds.resize(6);
-  if (seeds.size() < 2) {
-    out.why = std::to_string(seeds.size()) + " lamp(s) within " +
-              std::to_string(int(q.pair_max_theta_deg)) +
-              " degrees of the optical axis: a pose needs two";
+  const Seeds seeds = seeds_of(blobs, q, 6);
+  const std::size_t ns = seeds.size(), nc = classes.size();
+  if (ns < 2) {
+    out.why = too_few_seeds(ns, q);
     return out;
-  }
-  const double sa = std::hypot(q.detection_sigma_deg, q.tilt_sigma_deg) * kDeg;
-  const std::size_t nc = classes.size(), ns = seeds.size();
-  std::vector<Vector2d> at(ns * nc);
-  std::vector<double> sigma(ns * nc, -1);
-  for (std::size_t j = 0; j < ns; ++j) {
-    const Vector3d rb = mount_R * seeds[j].ray;
-    for (std::size_t c = 0; c < nc; ++c) {
-      const double h = classes[c].height;
-      if (h < 0.2) continue;
-      at[j * nc + c] = mount_t.head<2>() + (h / rb.z()) * rb.head<2>();
-      sigma[j * nc + c] = h * sa / (rb.z() * rb.z()) + 0.1 * classes[c].length;
-    }
   }
   // Candidate poses, one per 0.25 m x 3 degree cell.
   std::unordered_map<std::int64_t, Pose2> cells;
-  const double cell_m = 0.25, cell_rad = 3 * kDeg;
   const std::size_t first = std::min<std::size_t>(3, ns);
   for (std::size_t j = 0; j < first; ++j)
     for (std::size_t k = j + 1; k < first; ++k)
-      for (const auto& [key, group] : pair_groups) {
-        const double sj = sigma[j * nc + key.first], sk = sigma[k * nc + key.second];
-        if (sj < 0 || sk < 0) continue;
-        const Vector2d& qi = at[j * nc + key.first];
-        const Vector2d& ql = at[k * nc + key.second];
-        const Vector2d dq = ql - qi;
-        const double dn = dq.norm(), dq_angle = std::atan2(dq.y(), dq.x());
-        const double tol = 3 * std::hypot(sj, sk) + 0.02;
-        auto lo = std::lower_bound(group.begin(), group.end(), dn - tol,
-                                   [](const LampPair& p, double v) { return p.distance < v; });
-        for (auto it = lo; it != group.end() && it->distance <= dn + tol; ++it) {
-          const Vector2d Li = lamps[it->a]->xyz.head<2>(), Ll = lamps[it->b]->xyz.head<2>();
-          const double yaw = wrap_angle(it->angle - dq_angle);
-          const double c = std::cos(yaw), s = std::sin(yaw);
-          const Vector2d mid_q = 0.5 * (qi + ql), mid_L = 0.5 * (Li + Ll);
-          const Vector2d p =
-              mid_L - Vector2d(c * mid_q.x() - s * mid_q.y(), s * mid_q.x() + c * mid_q.y());
-          const std::int64_t cell_key = (std::int64_t(std::floor(p.x() / cell_m)) * 1000003 +
-                                         std::int64_t(std::floor(p.y() / cell_m))) *
-                                            1009 +
-                                        std::int64_t(std::floor((yaw + M_PI) / cell_rad));
-          cells.emplace(cell_key, Pose2(p, yaw));
-        }
-      }
+      pair_poses(seeds, j, k, [&](const Pose2& p) { cells.emplace(cell_of(p), p); });
   const double screen = q.pair_max_theta_deg * kDeg;
   std::vector<BlobRay> near;
   for (const BlobRay& b : blobs)
@@ -240,10 +215,11 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
     for (std::size_t j = 0; j < ns && misses <= 1; ++j) {
       bool on_lamp = false;
       for (std::size_t cl = 0; cl < nc && !on_lamp; ++cl) {
-        if (sigma[j * nc + cl] < 0 || sigma[j * nc + cl] > 0.5) continue;
-        const Vector2d& b = at[j * nc + cl];
+        const double sg = seeds.sigma[j * nc + cl];
+        if (sg < 0) continue;
+        const Vector2d& b = seeds.at[j * nc + cl];
         const Vector2d w = pose.translation() + Vector2d(c * b.x() - s * b.y(), s * b.x() + c * b.y());
-        const double r = 3 * sigma[j * nc + cl] + 0.3;
+        const double r = 3 * sg + 0.3;
         for (const graph::Lamp* l : map->lamps_within(w, r))
           if (class_of[lamp_index.at(l)] == int(cl)) on_lamp = true;
       }

@@ -82,18 +82,6 @@ TEST(Hypotheses, GridOfficeKidnapsIntoLookAlikeCorridors) {
 namespace lampnav::fusion {
 namespace {
 
-// A generated building with the asymmetries real ones have: rooms off some corridors, a missing
-// corridor, an east wing with another lamp spacing, a lobby.
-sim::BuildingOptions asymmetric(int nodes) {
-  sim::BuildingOptions o;
-  o.nodes = nodes;
-  o.missing_corridors = 1;
-  o.wing_lamp_spacing_m = 2.7;
-  o.lobby = true;
-  o.seed = 5;
-  return o;
-}
-
 // LAMPNAV_TRACE=1 prints the hypotheses after every omni frame.
 test::BatteryOptions traced() {
   test::BatteryOptions o;
@@ -121,7 +109,7 @@ test::BatteryOptions traced() {
 }
 
 void kidnaps_on(int nodes, int episodes) {
-  const Building w(asymmetric(nodes));
+  const Building w(test::asymmetric_building(nodes));
   test::Battery battery(w.map, w.robot, traced());
   std::vector<test::EpisodeResult> rs;
   for (int k = 1; k <= episodes; ++k) {
@@ -140,7 +128,7 @@ TEST(Hypotheses, DISABLED_KidnapsOnAGeneratedBuildingOf1000Nodes) { kidnaps_on(1
 TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf100Nodes) { kidnaps_on(100, 10); }
 
 TEST(Hypotheses, UnknownStartsOnAGeneratedBuildingOf100Nodes) {
-  const Building w(asymmetric(100));
+  const Building w(test::asymmetric_building(100));
   test::Battery battery(w.map, w.robot);
   std::vector<test::EpisodeResult> rs;
   for (int k = 1; k <= 8; ++k) {

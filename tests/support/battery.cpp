@@ -304,31 +304,23 @@ BatteryFigures figures(const std::vector<EpisodeResult>& rs) {
 }
 
 std::string summarize(const std::vector<EpisodeResult>& rs) {
-  int detected = 0, fixed = 0, correct = 0, wrong = 0;
-  std::vector<double> lat_s, lat_m;
-  std::size_t hyp = 0;
-  for (const auto& r : rs) {
-    detected += r.detected;
-    fixed += r.fixed;
-    correct += r.fix_correct;
-    wrong += r.wrong_fixes;
-    hyp = std::max(hyp, r.max_hypotheses);
-    if (r.fixed) {
-      lat_s.push_back(r.latency_s);
-      lat_m.push_back(r.latency_m);
-    }
-  }
-  auto pct = [](std::vector<double> v, double q) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    return v[std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5))];
-  };
+  const BatteryFigures f = figures(rs);
   std::ostringstream s;
-  s << rs.size() << " episodes: " << detected << " detected, " << fixed << " fixed, " << correct
-    << " correct, " << wrong << " wrong fixes; latency median " << pct(lat_s, 0.5) << " s / "
-    << pct(lat_m, 0.5) << " m, p95 " << pct(lat_s, 0.95) << " s / " << pct(lat_m, 0.95)
-    << " m; at most " << hyp << " hypotheses";
+  s << f.episodes << " episodes: " << f.detected << " detected, " << f.fixed << " fixed, "
+    << f.correct << " correct, " << f.wrong_fixes << " wrong fixes; latency median "
+    << f.latency_s_median << " s / " << f.latency_m_median << " m, p95 " << f.latency_s_p95
+    << " s / " << f.latency_m_p95 << " m; at most " << f.max_hypotheses << " hypotheses";
   return s.str();
+}
+
+sim::BuildingOptions asymmetric_building(int nodes) {
+  sim::BuildingOptions o;
+  o.nodes = nodes;
+  o.missing_corridors = 1;
+  o.wing_lamp_spacing_m = 2.7;
+  o.lobby = true;
+  o.seed = 5;
+  return o;
 }
 
 }  // namespace lampnav::test

@@ -17,6 +17,7 @@
 #include "lampnav/core/robot_description.hpp"
 #include "lampnav/fusion/localizer.hpp"
 #include "lampnav/graph/map.hpp"
+#include "lampnav/sim/building.hpp"
 #include "lampnav/sim/lamp_sensors.hpp"
 
 namespace lampnav::test {
@@ -75,6 +76,10 @@ class Battery {
 };
 
 std::string summarize(const std::vector<EpisodeResult>& results);
+
+// A generated building with the asymmetries real ones have: rooms off some corridors, a missing
+// corridor, an east wing with another lamp spacing (2.7 m against 2.25 m), a lobby.
+sim::BuildingOptions asymmetric_building(int nodes);
 
 // The figures of a battery: counts, and latency percentiles over the episodes that fixed.
 struct BatteryFigures {
