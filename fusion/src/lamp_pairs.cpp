@@ -253,6 +253,14 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
     if (q.restrict_to_graph && has_regions && !node_of(h.pose)) continue;
     refined.push_back(std::move(h));
   }
+  // The plausible ones (within the ambiguity margin of the best, 32 at most) refined in full,
+  // with the floor's tilt: one of them may be published from this image alone.
+  std::stable_sort(refined.begin(), refined.end(),
+                   [](const PoseHypothesis& a, const PoseHypothesis& b) { return a.score < b.score; });
+  for (std::size_t k = 0; k < refined.size() && k < 32; ++k) {
+    if (refined[k].score > refined.front().score + q.ambiguity_margin) break;
+    refined[k] = refine(refined[k].pose, 0.1, 1 * kDeg, blobs);
+  }
   finish(out, refined, d, q, static_cast<int>(limit));
   std::size_t kept = 0;
   for (const auto& h : out.hypotheses)
