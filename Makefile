@@ -26,10 +26,10 @@ demo: build
 	$(LAMPNAV) run --out $(OUT)
 	@echo "open $(OUT)/report.html" >&2
 
-# The official TypeScript MCAP reader, for the interoperability test (npm registry, pinned by the
-# lock file).
+# The official TypeScript MCAP reader and Foxglove's schemas, for the interoperability tests (npm
+# registry, pinned by the lock file).
 interop-deps: deps
-	@cd tests/interop && { [ -d node_modules/@mcap/core ] || npm ci --no-audit --no-fund --loglevel=error; }
+	@cd tests/interop && { [ -d node_modules/@mcap/core ] && [ -d node_modules/@foxglove/schemas ] || npm ci --no-audit --no-fund --loglevel=error; }
 
 test: build interop-deps
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)

@@ -135,7 +135,11 @@ void add_counter(const std::string& what, const std::string& bench, const std::s
 // A localization battery (bench/localization_bench.cpp): every episode relocalized to the true
 // place (kidnaps: detected too) and not one wrong fix; the latency beside it.
 void add_battery(const std::string& what, const std::string& bench, bool kidnaps) {
-  Row r{what, "not run", "", "", kidnaps ? "all detected, all right, 0 wrong" : "all right, 0 wrong",
+  Row r{what,
+        "not run",
+        "",
+        "",
+        kidnaps ? "all detected, all right, 0 wrong" : "all right, 0 wrong",
         "MISSED"};
   Json j{{"case", what}};
   auto it = results.find(bench);
@@ -166,8 +170,7 @@ void add_battery(const std::string& what, const std::string& bench, bool kidnaps
     std::ostringstream name;
     name << std::setprecision(3) << "  localizer per frame while unsure ("
          << c["unsure_mean_hypotheses"].get<double>() << " hypotheses on average)";
-    add(name.str(), c["unsure_us_per_frame"].get<double>(), "", std::nullopt, 2000.0,
-        std::nullopt);
+    add(name.str(), c["unsure_us_per_frame"].get<double>(), "", std::nullopt, 2000.0, std::nullopt);
   }
 }
 

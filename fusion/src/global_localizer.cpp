@@ -55,8 +55,8 @@ void GlobalLocalizerOptions::validate() const {
   check(q.distinct_m > 0 && q.distinct_deg > 0, "pairs.distinct_m", "must be positive");
   check(q.candidates >= 1 && q.refined >= 1 && q.refined <= q.candidates, "pairs.candidates",
         "must be positive, with refined <= candidates");
-  check(q.complete_vote_fraction > 0 && q.complete_vote_fraction <= 1, "pairs.complete_vote_fraction",
-        "must be in (0, 1]");
+  check(q.complete_vote_fraction > 0 && q.complete_vote_fraction <= 1,
+        "pairs.complete_vote_fraction", "must be in (0, 1]");
   check(max_hypotheses >= 1, "max_hypotheses", "must be positive");
 }
 
@@ -136,7 +136,8 @@ std::vector<int> GlobalLocalizer::Impl::lamps_in_view(const Pose2& pose, double 
     for (std::size_t i = 0; i < lamps.size(); ++i) out[i] = static_cast<int>(i);
     return out;
   }
-  for (const graph::Lamp* l : map->lamps_within(pose.translation(), radius > 0 ? radius : view_radius))
+  for (const graph::Lamp* l :
+       map->lamps_within(pose.translation(), radius > 0 ? radius : view_radius))
     out.push_back(lamp_index.at(l));
   std::sort(out.begin(), out.end());  // the map's order, so that results do not depend on the index
   return out;
@@ -170,12 +171,11 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     const std::vector<BlobRay>& blobs, double screen_theta) const {
   const LampPairOptions& q = o.pairs;
   const double max_theta = screen_theta > 0 ? screen_theta : q.max_theta_deg * kDeg;
-  const double expect_theta =
-      screen_theta > 0 ? screen_theta : q.expect_max_theta_deg * kDeg;
-  const double radius =
-      screen_theta > 0
-          ? max_height * std::tan(std::min(screen_theta, 89.0 * kDeg)) + mount_t.head<2>().norm() + 3.0
-          : 0.0;
+  const double expect_theta = screen_theta > 0 ? screen_theta : q.expect_max_theta_deg * kDeg;
+  const double radius = screen_theta > 0
+                            ? max_height * std::tan(std::min(screen_theta, 89.0 * kDeg)) +
+                                  mount_t.head<2>().norm() + 3.0
+                            : 0.0;
   const double det = q.detection_sigma_deg * kDeg;
   const double cos_limit = std::cos(std::min(M_PI, max_theta + 0.1));
   struct Predicted {
@@ -439,8 +439,9 @@ GlobalLocalization GlobalLocalizer::locate(const vision::OmniDetection& d,
     out.why = "no lamp in the image";
     return out;
   }
-  return method == GlobalMethod::paper ? impl_->paper(d)
-                                        : impl_->lamp_pairs(d, impl_->o.pairs, impl_->o.max_hypotheses);
+  return method == GlobalMethod::paper
+             ? impl_->paper(d)
+             : impl_->lamp_pairs(d, impl_->o.pairs, impl_->o.max_hypotheses);
 }
 
 GlobalLocalization GlobalLocalizer::enumerate(const vision::OmniDetection& d, int cap,
@@ -458,8 +459,9 @@ GlobalLocalizer::PoseScore GlobalLocalizer::score(const Pose2& pose, double posi
   PoseScore s;
   if (d.flooded) return s;
   const std::vector<BlobRay> blobs = m.blob_rays(d, m.o.pairs.max_theta_deg * kDeg);
-  const Evaluation e = m.evaluate(pose, {}, std::max(1e-3, position_sigma),
-                                  std::max(1e-4, yaw_sigma), m.o.pairs.tilt_sigma_deg * kDeg, blobs);
+  const Evaluation e =
+      m.evaluate(pose, {}, std::max(1e-3, position_sigma), std::max(1e-4, yaw_sigma),
+                 m.o.pairs.tilt_sigma_deg * kDeg, blobs);
   s.cost = e.cost;
   s.expected = e.expected;
   s.missing = e.missing;

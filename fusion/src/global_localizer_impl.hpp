@@ -179,7 +179,8 @@ struct GlobalLocalizer::Impl {
     std::vector<double> sigma;
     std::size_t size() const { return rays.size(); }
   };
-  Seeds seeds_of(const std::vector<BlobRay>& blobs, const LampPairOptions& q, std::size_t max) const;
+  Seeds seeds_of(const std::vector<BlobRay>& blobs, const LampPairOptions& q,
+                 std::size_t max) const;
   // Each pose that puts seeds j and k on a pair of map lamps spaced like them (both classes'
   // index looked up by spacing): fn(pose).
   template <class Fn>

@@ -55,8 +55,8 @@ void HypothesisSetOptions::validate() const {
   check(birth_sigma_m > 0 && birth_sigma_deg > 0, "birth_sigma_m", "must be positive");
   check(kept_prior > 0 && kept_prior < 1, "kept_prior", "must be in (0, 1)");
   check(merge_m > 0 && merge_deg > 0, "merge_m", "must be positive");
-  check(sigma_m > 0 && sigma_per_m >= 0 && sigma_yaw_deg > 0 && sigma_yaw_deg_per_m >= 0,
-        "sigma_m", "odometry sigmas must be positive");
+  check(sigma_m > 0 && sigma_per_m >= 0 && sigma_yaw_deg > 0 && sigma_yaw_deg_per_m >= 0, "sigma_m",
+        "odometry sigmas must be positive");
   check(wall_margin_m >= 0, "wall_margin_m", "must not be negative");
   check(omni_bump_sigma_m >= 0 && omni_bump_sigma_deg >= 0, "omni_bump_sigma_m",
         "must not be negative");
@@ -76,7 +76,7 @@ struct HypothesisSet::Impl {
 
   std::vector<Hypothesis> hs;  // best first after every frame
   bool complete = false;
-  int omni_frames = 0;   // omni frames that weighed the set since it became complete
+  int omni_frames = 0;  // omni frames that weighed the set since it became complete
   int next_id = 1;
   std::string last_why = "no omni image yet";
   Counts counts;
@@ -208,8 +208,7 @@ struct HypothesisSet::Impl {
   Weighed weigh_omni(Hypothesis& h, const vision::OmniDetection& d, bool refine) const {
     const double ps = std::clamp(sigma_position(h.covariance), 0.03, 1.5);
     const double ys = std::clamp(std::sqrt(h.covariance(2, 2)), 0.5 * kDeg, 15 * kDeg);
-    const std::optional<PoseHypothesis> r =
-        refine ? omni->refine(h.pose, ps, ys, d) : std::nullopt;
+    const std::optional<PoseHypothesis> r = refine ? omni->refine(h.pose, ps, ys, d) : std::nullopt;
     if (r && r->matches.size() >= 2) {
       Eigen::Matrix3d R = r->covariance;
       R.diagonal() += Eigen::Vector3d(o.omni_bump_sigma_m * o.omni_bump_sigma_m,
@@ -252,7 +251,8 @@ struct HypothesisSet::Impl {
       const std::optional<PoseMeasurement> m =
           measure_pose(*geometry, camera->parameters().fx, labelled, h.pose, Stamp{}, measurement,
                        nullptr, &refusal);
-      if (m) cost += update(h, m->pose, m->covariance);
+      if (m)
+        cost += update(h, m->pose, m->covariance);
       else if (refusal == PoseRefusal::labels_disagree)
         cost += o.ceiling_spurious_cost;
     }
@@ -343,9 +343,9 @@ struct HypothesisSet::Impl {
     // One image's least squares knows its noise, not the floor's bumps nor its own aliasing: a
     // newborn is held loosely until the next frames have refined it.
     h.covariance = p.covariance;
-    h.covariance.diagonal() += Eigen::Vector3d(o.birth_sigma_m * o.birth_sigma_m,
-                                               o.birth_sigma_m * o.birth_sigma_m,
-                                               std::pow(o.birth_sigma_deg * kDeg, 2));
+    h.covariance.diagonal() +=
+        Eigen::Vector3d(o.birth_sigma_m * o.birth_sigma_m, o.birth_sigma_m * o.birth_sigma_m,
+                        std::pow(o.birth_sigma_deg * kDeg, 2));
     h.odometry = odo.at(stamp);
     h.log_weight = log_weight;
     h.node = p.node;
@@ -382,8 +382,8 @@ struct HypothesisSet::Impl {
         }
       const double each = std::log((1 - kept_share) / double(std::max(1, r.plausible)));
       for (std::size_t k = 0; k < n; ++k)
-        next.push_back(born(r.hypotheses[k], stamp, odo,
-                            each - 0.5 * (r.hypotheses[k].score - best_score)));
+        next.push_back(
+            born(r.hypotheses[k], stamp, odo, each - 0.5 * (r.hypotheses[k].score - best_score)));
       hs = std::move(next);
       complete = true;
       omni_frames = 1;  // this image weighed them
@@ -436,8 +436,9 @@ void HypothesisSet::keep(Stamp stamp, const Pose2& pose, const Eigen::Matrix3d& 
   h.weight = 1;
   h.node = m.map->node_containing(pose.translation());
   m.hs.push_back(h);
-  m.last_why = "the kidnap alarm fired: the tracked pose is one hypothesis among those the "
-               "omni camera will find";
+  m.last_why =
+      "the kidnap alarm fired: the tracked pose is one hypothesis among those the "
+      "omni camera will find";
 }
 
 void HypothesisSet::omni(Stamp stamp, const vision::OmniDetection& d,

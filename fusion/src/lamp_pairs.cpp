@@ -18,8 +18,7 @@ GlobalLocalizer::Impl::Seeds GlobalLocalizer::Impl::seeds_of(const std::vector<B
   Seeds s;
   // Nearest the optical axis, where a ray says most about position.
   for (const BlobRay& b : blobs)
-    if (b.theta <= q.pair_max_theta_deg * kDeg && (mount_R * b.ray).z() > 0.05)
-      s.rays.push_back(b);
+    if (b.theta <= q.pair_max_theta_deg * kDeg && (mount_R * b.ray).z() > 0.05) s.rays.push_back(b);
   std::sort(s.rays.begin(), s.rays.end(),
             [](const BlobRay& a, const BlobRay& b) { return a.theta < b.theta; });
   if (s.rays.size() > max) s.rays.resize(max);
@@ -174,7 +173,6 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
   return out;
 }
 
-
 // Every pose that puts a map lamp under each of two blobs near the optical axis: the pair of
 // blobs matched to every pair of map lamps spaced like them (both ways round), for the three
 // pairs of the three blobs nearest the axis, so that one spurious or merged blob among them
@@ -218,7 +216,8 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
         const double sg = seeds.sigma[j * nc + cl];
         if (sg < 0) continue;
         const Vector2d& b = seeds.at[j * nc + cl];
-        const Vector2d w = pose.translation() + Vector2d(c * b.x() - s * b.y(), s * b.x() + c * b.y());
+        const Vector2d w =
+            pose.translation() + Vector2d(c * b.x() - s * b.y(), s * b.x() + c * b.y());
         const double r = 3 * sg + 0.3;
         for (const graph::Lamp* l : map->lamps_within(w, r))
           if (class_of[lamp_index.at(l)] == int(cl)) on_lamp = true;
@@ -255,8 +254,9 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   }
   // The plausible ones (within the ambiguity margin of the best, 32 at most) refined in full,
   // with the floor's tilt: one of them may be published from this image alone.
-  std::stable_sort(refined.begin(), refined.end(),
-                   [](const PoseHypothesis& a, const PoseHypothesis& b) { return a.score < b.score; });
+  std::stable_sort(
+      refined.begin(), refined.end(),
+      [](const PoseHypothesis& a, const PoseHypothesis& b) { return a.score < b.score; });
   for (std::size_t k = 0; k < refined.size() && k < 32; ++k) {
     if (refined[k].score > refined.front().score + q.ambiguity_margin) break;
     refined[k] = refine(refined[k].pose, 0.1, 1 * kDeg, blobs);

@@ -311,9 +311,12 @@ const CeilingObservation& Localizer::ceiling_frame(Stamp stamp, const vision::Im
   Impl& m = *impl_;
   if (!m.pipeline)
     throw InputError({"", "robot.json", "cameras"}, "the robot has no ceiling_camera");
-  return m.ceiling(stamp, [&](const Pose2& pose, const Eigen::Matrix3d& P) {
-    return m.pipeline->process(stamp, image, pose, P);
-  }, *this);
+  return m.ceiling(
+      stamp,
+      [&](const Pose2& pose, const Eigen::Matrix3d& P) {
+        return m.pipeline->process(stamp, image, pose, P);
+      },
+      *this);
 }
 
 const CeilingObservation& Localizer::ceiling_detections(
@@ -321,9 +324,12 @@ const CeilingObservation& Localizer::ceiling_detections(
   Impl& m = *impl_;
   if (!m.pipeline)
     throw InputError({"", "robot.json", "cameras"}, "the robot has no ceiling_camera");
-  return m.ceiling(stamp, [&](const Pose2& pose, const Eigen::Matrix3d& P) {
-    return m.pipeline->process(stamp, lamps, pose, P);
-  }, *this);
+  return m.ceiling(
+      stamp,
+      [&](const Pose2& pose, const Eigen::Matrix3d& P) {
+        return m.pipeline->process(stamp, lamps, pose, P);
+      },
+      *this);
 }
 
 void Localizer::ceiling_observation(const CeilingObservation& ob) {

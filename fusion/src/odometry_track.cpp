@@ -12,7 +12,8 @@ Pose2 interpolate(const Pose2& a, const Pose2& b, double f) {
                wrap_angle(a.yaw() + f * wrap_angle(b.yaw() - a.yaw())));
 }
 
-OdometryTrack::OdometryTrack(double semi_axis, Duration kept) : semi_axis_(semi_axis), kept_(kept) {}
+OdometryTrack::OdometryTrack(double semi_axis, Duration kept)
+    : semi_axis_(semi_axis), kept_(kept) {}
 
 void OdometryTrack::add(Stamp stamp, double dl, double dr) {
   if (!std::isfinite(dl) || !std::isfinite(dr)) return;

@@ -1,5 +1,7 @@
 #include "lampnav/io/mission_log.hpp"
 
+#include "foxglove_schemas.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -118,6 +120,10 @@ namespace {
 
 Json stamp_json(Stamp t) {
   const std::int64_t ns = to_nanoseconds(t);
+  if (ns < 0)
+    throw InputError({"", "mission log", "timestamp"},
+                     "a time before 1970 (" + std::to_string(ns) +
+                         " ns) cannot be written: Foxglove's time is unsigned");
   std::int64_t sec = ns / 1'000'000'000;
   std::int64_t nsec = ns % 1'000'000'000;
   if (nsec < 0) {
@@ -127,8 +133,9 @@ Json stamp_json(Stamp t) {
   return Json{{"sec", sec}, {"nsec", nsec}};
 }
 
+// Foxglove's time: unsigned seconds and nanoseconds (a negative stamp is refused when writing).
 const char* const kTimeSchema =
-    R"("timestamp": {"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer", "minimum": 0}}})";
+    R"("timestamp": {"type": "object", "title": "time", "properties": {"sec": {"type": "integer", "minimum": 0}, "nsec": {"type": "integer", "minimum": 0, "maximum": 999999999}}})";
 
 struct ChannelSpec {
   const char* topic;
@@ -142,34 +149,25 @@ std::vector<ChannelSpec> channel_specs() {
       {topics::kWheels, "lampnav.WheelOdometry",
        R"({"type": "object", "properties": {)" + t +
            R"(, "left": {"type": "number"}, "right": {"type": "number"}}})"},
-      {topics::kCeilingImage, "foxglove.CompressedImage",
-       R"({"type": "object", "properties": {)" + t +
-           R"(, "frame_id": {"type": "string"}, "data": {"type": "string", "contentEncoding": "base64"}, "format": {"type": "string"}}})"},
-      {topics::kOmniImage, "foxglove.CompressedImage",
-       R"({"type": "object", "properties": {)" + t +
-           R"(, "frame_id": {"type": "string"}, "data": {"type": "string", "contentEncoding": "base64"}, "format": {"type": "string"}}})"},
-      {topics::kTruth, "foxglove.PoseInFrame",
-       R"({"type": "object", "properties": {)" + t +
-           R"(, "frame_id": {"type": "string"}, "pose": {"type": "object", "properties": {"position": {"type": "object"}, "orientation": {"type": "object"}}}}})"},
+      {topics::kCeilingImage, "foxglove.CompressedImage", foxglove_schemas::kCompressedImage},
+      {topics::kOmniImage, "foxglove.CompressedImage", foxglove_schemas::kCompressedImage},
+      {topics::kTruth, "foxglove.PoseInFrame", foxglove_schemas::kPoseInFrame},
       {topics::kEvents, "lampnav.Event",
        R"({"type": "object", "properties": {)" + t +
            R"(, "kind": {"type": "string"}, "detail": {"type": "string"}}})"},
       {topics::kCommands, "lampnav.Command",
        R"({"type": "object", "properties": {)" + t + R"(, "text": {"type": "string"}}})"},
-      {topics::kPose, "foxglove.PoseInFrame",
-       R"({"type": "object", "properties": {)" + t +
-           R"(, "frame_id": {"type": "string"}, "pose": {"type": "object", "properties": {"position": {"type": "object"}, "orientation": {"type": "object"}}}}})"},
+      {topics::kPose, "foxglove.PoseInFrame", foxglove_schemas::kPoseInFrame},
       {topics::kEstimate, "lampnav.PoseEstimate",
        R"({"type": "object", "properties": {)" + t +
-           R"(, "x": {"type": "number"}, "y": {"type": "number"}, "yaw": {"type": "number"}, "covariance": {"type": "array", "items": {"type": "number"}, "minItems": 9, "maxItems": 9}, "node": {"type": ["string", "null"]}, "mode": {"type": "string", "enum": ["tracking", "lost", "relocalized", "ambiguous"]}}})"},
+           R"(, "x": {"type": "number"}, "y": {"type": "number"}, "yaw": {"type": "number"}, "covariance": {"type": "array", "items": {"type": "number"}, "minItems": 9, "maxItems": 9}, "node": {"type": "string"}, "mode": {"type": "string", "enum": ["tracking", "lost", "relocalized", "ambiguous"]}}})"},
       {topics::kHypotheses, "lampnav.Hypotheses",
        R"({"type": "object", "properties": {)" + t +
            R"(, "mode": {"type": "string", "enum": ["tracking", "lost", "relocalized", "ambiguous"]}, "hypotheses": {"type": "array", "items": {"type": "object", "properties": {"x": {"type": "number"}, "y": {"type": "number"}, "yaw": {"type": "number"}, "weight": {"type": "number"}, "node": {"type": "string"}}}}}})"},
       {topics::kLamps, "lampnav.LampObservations",
        R"({"type": "object", "properties": {)" + t +
-           R"(, "camera": {"type": "string"}, "lamps": {"type": "array", "items": {"type": "object", "properties": {"u": {"type": "number"}, "v": {"type": "number"}, "orientation": {"type": "number"}, "area": {"type": "number"}, "track": {"type": "integer"}, "label": {"type": ["string", "null"]}}}}}})"},
-      {topics::kScene, "foxglove.SceneUpdate",
-       R"({"type": "object", "properties": {"deletions": {"type": "array"}, "entities": {"type": "array"}}})"},
+           R"(, "camera": {"type": "string"}, "lamps": {"type": "array", "items": {"type": "object", "properties": {"u": {"type": "number"}, "v": {"type": "number"}, "orientation": {"type": "number"}, "area": {"type": "number"}, "track": {"type": "integer"}, "label": {"type": "string"}}}}}})"},
+      {topics::kScene, "foxglove.SceneUpdate", foxglove_schemas::kSceneUpdate},
   };
 }
 
@@ -240,7 +238,7 @@ void MissionLogWriter::write_image(Stamp available, const ImageFrame& f) {
   impl_->put(topic, available, f.stamp,
              Json{{"timestamp", stamp_json(f.stamp)},
                   {"frame_id", f.frame_id},
-                  {"format", f.format},
+                  {"format", f.format == "jpg" ? std::string("jpeg") : f.format},
                   {"data", base64_encode(f.data)}});
 }
 void MissionLogWriter::write(Stamp available, const PoseEstimate& e) {
@@ -255,7 +253,7 @@ void MissionLogWriter::write(Stamp available, const PoseEstimate& e) {
                   {"y", e.pose.y()},
                   {"yaw", e.pose.yaw()},
                   {"covariance", cov},
-                  {"node", e.node.empty() ? Json(nullptr) : Json(e.node)},
+                  {"node", e.node},  // "" in no region: Foxglove parses no type unions
                   {"mode", e.mode}});
 }
 
@@ -267,7 +265,7 @@ void MissionLogWriter::write(Stamp available, const LampObservations& o) {
                      {"orientation", l.orientation},
                      {"area", l.area},
                      {"track", l.track},
-                     {"label", l.label ? Json(*l.label) : Json(nullptr)}});
+                     {"label", l.label.value_or("")}});  // "" unlabelled
   impl_->put(topics::kLamps, available, o.stamp,
              Json{{"timestamp", stamp_json(o.stamp)}, {"camera", o.camera}, {"lamps", lamps}});
 }

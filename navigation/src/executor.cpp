@@ -100,8 +100,8 @@ std::optional<WheelSpeeds> Executor::explore(const fusion::LocalizerEstimate& e)
     if (!n || !n->axis) return std::nullopt;
     Eigen::Vector2d d = n->axis->direction();
     if (d.dot(Eigen::Vector2d(std::cos(p.yaw()), std::sin(p.yaw()))) < 0) d = -d;
-    const Eigen::Vector2d end = d.dot(n->axis->second - n->axis->first) > 0 ? n->axis->second
-                                                                           : n->axis->first;
+    const Eigen::Vector2d end =
+        d.dot(n->axis->second - n->axis->first) > 0 ? n->axis->second : n->axis->first;
     return std::pair{(end - p.translation()).dot(d), d};
   };
   const auto lead = ahead(e.pose);
@@ -187,8 +187,8 @@ WheelSpeeds Executor::step(const fusion::LocalizerEstimate& e) {
       explore_stamp_.reset();
       explore_noted_ = false;
       status_ = ExecutorStatus::waiting;
-      note(e.stamp, std::string(fusion::to_string(e.mode)) +
-                        ": stopped, waiting for relocalization");
+      note(e.stamp,
+           std::string(fusion::to_string(e.mode)) + ": stopped, waiting for relocalization");
     }
     if (e.mode == fusion::LocalizerMode::ambiguous && e.undecidable) {
       fail(e.stamp, "the robot cannot tell where it is: " + e.why);

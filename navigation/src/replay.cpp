@@ -133,7 +133,8 @@ ErrorStats stats_of(const std::vector<double>& v) {
 // Why a replay never published a pose, in words: what the localizer last said.
 std::string never_localized(const ReplayResult& r, const io::MissionLog& log) {
   std::string s = "the robot was never localized";
-  if (!r.events.empty()) s += ": " + r.events.back().reason;
+  if (!r.events.empty())
+    s += ": " + r.events.back().reason;
   else if (r.outcome.omni_frames == 0 && !log.omni_images.empty())
     s += ": no omni frame could be used";
   else if (r.outcome.omni_frames == 0)
@@ -212,8 +213,8 @@ void score(ReplayResult& r, const io::MissionLog& log) {
   }
   bool wrong = false;
   for (const auto& e : r.estimates) {
-    const bool certain = e.mode == fusion::LocalizerMode::tracking ||
-                         e.mode == fusion::LocalizerMode::relocalized;
+    const bool certain =
+        e.mode == fusion::LocalizerMode::tracking || e.mode == fusion::LocalizerMode::relocalized;
     bool excused = false;
     for (const auto& [from, to] : unnoticed)
       if (e.stamp >= from && e.stamp <= to) excused = true;  // an estimate at the instant of
@@ -269,11 +270,11 @@ ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
   for (const auto& e : ev)
     if (e.reason != "initialized") r.events.push_back(e);
   // Wheels alone, from the first pose the stack had.
-  const auto known = std::find_if(r.estimates.begin(), r.estimates.end(),
-                                  [](const EstimateSample& e) {
-                                    return e.mode == fusion::LocalizerMode::tracking ||
-                                           e.mode == fusion::LocalizerMode::relocalized;
-                                  });
+  const auto known =
+      std::find_if(r.estimates.begin(), r.estimates.end(), [](const EstimateSample& e) {
+        return e.mode == fusion::LocalizerMode::tracking ||
+               e.mode == fusion::LocalizerMode::relocalized;
+      });
   if (known != r.estimates.end()) {
     const Stamp from = known->stamp;
     fusion::StateVector x = known->pose.vector();

@@ -25,8 +25,7 @@ void BuildingOptions::validate() const {
   check(ceiling_m > 1 && ceiling_m < 50, "ceiling_m", "must be 1 to 50 m");
   check(missing_corridors >= 0 && missing_corridors <= 1000, "missing_corridors",
         "must be 0 to 1000");
-  check(wing_lamp_spacing_m == 0 ||
-            (wing_lamp_spacing_m >= 0.5 && wing_lamp_spacing_m < block_m),
+  check(wing_lamp_spacing_m == 0 || (wing_lamp_spacing_m >= 0.5 && wing_lamp_spacing_m < block_m),
         "wing_lamp_spacing_m", "must be 0 (none) or at least 0.5 m and less than a block");
 }
 
@@ -113,7 +112,8 @@ Building generate_building(const BuildingOptions& o) {
     auto id = [k](int i, int j) { return i * k + j; };
     for (int i = 0; i + 1 < k; ++i)
       for (int j = 0; j < k; ++j)
-        if (!(j + 1 < k && has_room[i * (k - 1) + j])) all.push_back({H(i, j), {id(i, j), id(i + 1, j)}});
+        if (!(j + 1 < k && has_room[i * (k - 1) + j]))
+          all.push_back({H(i, j), {id(i, j), id(i + 1, j)}});
     for (int i = 0; i < k; ++i)
       for (int j = 0; j + 1 < k; ++j) all.push_back({V(i, j), {id(i, j), id(i, j + 1)}});
     std::shuffle(all.begin(), all.end(), rng);
@@ -158,10 +158,10 @@ Building generate_building(const BuildingOptions& o) {
   for (int i = 0; i < k; ++i)
     for (int j = 0; j < k; ++j) {
       const int n = exits(i, j) + (o.lobby && i == 0 && j == 0 ? 1 : 0);
-      const bool straight = n == 2 && ((i > 0 && i + 1 < k && !missing.count(H(i - 1, j)) &&
-                                        !missing.count(H(i, j))) ||
-                                       (j > 0 && j + 1 < k && !missing.count(V(i, j - 1)) &&
-                                        !missing.count(V(i, j))));
+      const bool straight =
+          n == 2 &&
+          ((i > 0 && i + 1 < k && !missing.count(H(i - 1, j)) && !missing.count(H(i, j))) ||
+           (j > 0 && j + 1 < k && !missing.count(V(i, j - 1)) && !missing.count(V(i, j))));
       const char* place = n <= 1 ? "end" : n == 2 && !straight ? "corner" : "junction";
       const double x = i * S, y = j * S;
       Json& md = w.node(J(i, j), place, x, y, Writer::region(x - 1, y - 1, x + 1, y + 1));
@@ -222,8 +222,8 @@ Building generate_building(const BuildingOptions& o) {
   if (o.lobby) {
     // A 10 x 8 m hall west of the origin's corner, entered from it, with round lamps in a grid.
     const double x0 = -11, x1 = -1, y0 = -4, y1 = 4;
-    Json& md = w.node("Lobby", "hall", 0.5 * (x0 + x1), 0.5 * (y0 + y1),
-                      Writer::region(x0, y0, x1, y1));
+    Json& md =
+        w.node("Lobby", "hall", 0.5 * (x0 + x1), 0.5 * (y0 + y1), Writer::region(x0, y0, x1, y1));
     int q = 0;
     for (double x = x0 + 1.25; x < x1; x += 2.5)
       for (double y = y0 + 2; y < y1; y += 2.0)

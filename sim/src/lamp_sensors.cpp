@@ -154,11 +154,10 @@ std::vector<vision::LampDetection> LampSensors::ceiling(const Pose2& pose,
     const Vector2d ax(std::cos(l->yaw), std::sin(l->yaw)), across(-ax.y(), ax.x());
     bool inside = true;
     for (int k = 0; k < 4 && inside; ++k) {
-      const Vector2d corner = l->xyz.head<2>() + (k & 1 ? half_l : -half_l) * ax +
-                              (k & 2 ? half_w : -half_w) * across;
-      const Vector3d cc =
-          Impl::in_camera(pose, Vector3d(corner.x(), corner.y(), l->xyz.z()), tilt, m.ceiling_R,
-                          m.ceiling_t);
+      const Vector2d corner =
+          l->xyz.head<2>() + (k & 1 ? half_l : -half_l) * ax + (k & 2 ? half_w : -half_w) * across;
+      const Vector3d cc = Impl::in_camera(pose, Vector3d(corner.x(), corner.y(), l->xyz.z()), tilt,
+                                          m.ceiling_R, m.ceiling_t);
       const auto p = cc.z() > 0 ? cam.project(cc) : std::nullopt;
       inside = p && p->x() >= 1 && p->y() >= 1 && p->x() <= cam.width() - 2 &&
                p->y() <= cam.height() - 2;
@@ -169,8 +168,8 @@ std::vector<vision::LampDetection> LampSensors::ceiling(const Pose2& pose,
     const Vector2d n(c.x() / c.z(), c.y() / c.z());
     d.centre_px = cam.pixel_of_normalized(n) + Vector2d(px_noise(rng), px_noise(rng));
     d.centre = cam.normalized_of_pixel(d.centre_px);
-    const Vector3d tip = Impl::in_camera(pose, l->xyz + Vector3d(ax.x(), ax.y(), 0) * half_l,
-                                         tilt, m.ceiling_R, m.ceiling_t);
+    const Vector3d tip = Impl::in_camera(pose, l->xyz + Vector3d(ax.x(), ax.y(), 0) * half_l, tilt,
+                                         m.ceiling_R, m.ceiling_t);
     const Vector2d axis = Vector2d(tip.x() / tip.z(), tip.y() / tip.z()) - n;
     double o = std::atan2(axis.y(), axis.x()) + axis_noise(rng);
     while (o > M_PI / 2) o -= M_PI;

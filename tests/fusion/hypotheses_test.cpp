@@ -44,9 +44,9 @@ TEST(Hypotheses, GridOfficeFromAnUnknownStartIsNeverConfidentlyWrong) {
   for (std::uint64_t seed = 1; seed <= 8; ++seed) {
     rs.push_back(battery.unknown_start(seed));
     const auto& r = rs.back();
-    std::cout << "seed " << seed << ": fixed " << r.fixed << " error " << r.fix_error_m
-              << " after " << r.latency_m << " m, wrong " << r.wrong_fixes << ", at most "
-              << r.max_hypotheses << " hypotheses " << r.last_why << "\n";
+    std::cout << "seed " << seed << ": fixed " << r.fixed << " error " << r.fix_error_m << " after "
+              << r.latency_m << " m, wrong " << r.wrong_fixes << ", at most " << r.max_hypotheses
+              << " hypotheses " << r.last_why << "\n";
   }
   std::cout << test::summarize(rs) << "\n";
   for (const auto& r : rs) {
@@ -63,10 +63,10 @@ TEST(Hypotheses, GridOfficeKidnapsIntoLookAlikeCorridors) {
   for (std::uint64_t seed = 1; seed <= 12; ++seed) {
     rs.push_back(battery.kidnap(seed));
     const auto& r = rs.back();
-    std::cout << "seed " << seed << ": detected " << r.detected << " fixed " << r.fixed
-              << " error " << r.fix_error_m << " after " << r.latency_s << " s " << r.latency_m
-              << " m, wrong " << r.wrong_fixes << ", at most " << r.max_hypotheses
-              << " hypotheses " << r.last_why << "\n";
+    std::cout << "seed " << seed << ": detected " << r.detected << " fixed " << r.fixed << " error "
+              << r.fix_error_m << " after " << r.latency_s << " s " << r.latency_m << " m, wrong "
+              << r.wrong_fixes << ", at most " << r.max_hypotheses << " hypotheses " << r.last_why
+              << "\n";
   }
   std::cout << test::summarize(rs) << "\n";
   for (const auto& r : rs) {
@@ -101,8 +101,7 @@ test::BatteryOptions traced() {
                 << " pose " << e.pose << " (" << loc.relocalization().why << ")";
       const auto& hs = loc.hypotheses().hypotheses();
       for (std::size_t k = 0; k < hs.size() && k < 4; ++k)
-        std::cout << " [" << hs[k].pose << " w " << hs[k].weight << " c " << hs[k].last_cost
-                  << "]";
+        std::cout << " [" << hs[k].pose << " w " << hs[k].weight << " c " << hs[k].last_cost << "]";
       std::cout << "\n";
     };
   return o;

@@ -1,10 +1,14 @@
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <sstream>
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/io/mcap.hpp"
+#include "lampnav/io/mission_log.hpp"
 #include "lampnav_test.hpp"
 
 namespace lampnav::io {
@@ -196,6 +200,44 @@ TEST(McapReader, RandomGarbageNeverCrashes) {
 TEST(Crc32, KnownValue) {
   const std::string s = "123456789";
   EXPECT_EQ(crc32(s.data(), s.size()), 0xCBF43926u);
+}
+
+}  // namespace
+}  // namespace lampnav::io
+
+// What Foxglove would refuse is refused when writing, or written as it expects.
+namespace lampnav::io {
+namespace {
+
+TEST(MissionLogWriter, RefusesANegativeTimeAndWritesJpegAsJpeg) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("lampnav_writer_" + std::to_string(::getpid()) + ".mcap"))
+                               .string();
+  {
+    MissionLogWriter w(path);
+    // Foxglove's time is unsigned: a stamp before 1970 cannot be written, and nothing is.
+    EXPECT_THROW(w.write(Stamp(std::chrono::seconds(1)),
+                         WheelReading{Stamp(std::chrono::seconds(-1)), 0, 0}),
+                 InputError);
+    w.write(Stamp(std::chrono::seconds(1)), WheelReading{Stamp(std::chrono::seconds(1)), 0.5, 0.5});
+    w.write_image(Stamp(std::chrono::seconds(2)),
+                  ImageFrame{Stamp(std::chrono::seconds(2)), "ceiling_camera", "jpg", "xyz"});
+    w.close();
+  }
+  const McapFile f = read_mcap(path);
+  std::size_t wheels = 0;
+  bool jpeg = false;
+  std::map<std::uint16_t, std::string> topic_of;
+  for (const auto& c : f.channels) topic_of[c.id] = c.topic;
+  for (const auto& m : f.messages) {
+    const std::string& topic = topic_of.at(m.channel_id);
+    if (topic == topics::kWheels) ++wheels;
+    if (topic == topics::kCeilingImage)
+      jpeg = m.data.find(R"("format":"jpeg")") != std::string::npos;
+  }
+  EXPECT_EQ(wheels, 1u);
+  EXPECT_TRUE(jpeg);
+  std::filesystem::remove(path);
 }
 
 }  // namespace

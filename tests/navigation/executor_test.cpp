@@ -2,10 +2,10 @@
 // it drives along the corridor to where the look-alike places differ (as far as the corridor runs
 // in every one of them); between symmetry twins it stops the mission and says why.
 
+#include "lampnav/navigation/executor.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/graph/route_commands.hpp"
-#include "lampnav/navigation/executor.hpp"
 #include "lampnav_test.hpp"
 
 namespace lampnav::navigation {
@@ -57,8 +57,7 @@ TEST(Executor, DrivesAlongTheCorridorWhileAmbiguousThenStops) {
   Executor ex = started(o, o.on_c1(2.0));
   // Two look-alike places, both facing along C1 (the twin 3 m further on).
   Pose2 p = o.on_c1(2.0);
-  const WheelSpeeds s =
-      ex.step(unsure(fusion::LocalizerMode::ambiguous, 1.0, p, {o.on_c1(5.0)}));
+  const WheelSpeeds s = ex.step(unsure(fusion::LocalizerMode::ambiguous, 1.0, p, {o.on_c1(5.0)}));
   EXPECT_GT(s.left, 0.1);
   EXPECT_NEAR(s.left, s.right, 0.05);  // straight on
   // Both places move alike; it stops by itself where the shorter corridor ahead (the twin's)

@@ -3,8 +3,8 @@
 // live estimates exactly, the metrics, the outputs the spec lists, and logs without truth, without
 // a camera, cut short). One mission per test process: it takes 20 s to drive.
 
-#include <algorithm>
 #include <unistd.h>
+#include <algorithm>
 
 #include <filesystem>
 #include <fstream>
@@ -111,10 +111,23 @@ void replay_writes_the_outputs(const Driven& d) {
     ++lines;
   }
   EXPECT_EQ(lines, static_cast<std::size_t>(std::count_if(
-                      r.estimates.begin(), r.estimates.end(), [](const EstimateSample& e) {
-                        return e.mode == fusion::LocalizerMode::tracking;
-                      })));
+                       r.estimates.begin(), r.estimates.end(), [](const EstimateSample& e) {
+                         return e.mode == fusion::LocalizerMode::tracking;
+                       })));
   EXPECT_LT(lines, r.estimates.size());  // not while lost or ambiguous
+  // Every topic parses as Foxglove parses it (no topic dropped), the foxglove.* ones carry the
+  // official schemas, and each channel's first message validates (tests/interop).
+  ASSERT_TRUE(fs::exists(test::source_path("tests/interop/node_modules/@foxglove/schemas")))
+      << "@foxglove/schemas is not installed: run `make test`, which installs it";
+  int status = -1;
+  const std::string checked =
+      test::run_command("cd '" + test::source_path("tests/interop") +
+                            "' && node check_schemas.mjs '" + out + "/replay.mcap' 2>&1",
+                        &status);
+  EXPECT_EQ(status, 0) << checked;
+  for (const char* topic : {"/truth/pose", "/lampnav/pose", "/lampnav/scene", "/lampnav/estimate",
+                            "/lampnav/lamps", "/lampnav/hypotheses", "/ceiling_camera/image"})
+    EXPECT_NE(checked.find(std::string("\"") + topic + "\""), std::string::npos) << topic;
   // The replay log reads back with the inputs and the estimates.
   const io::MissionLog back = io::read_mission_log(out + "/replay.mcap");
   EXPECT_EQ(back.wheels.size(), log.wheels.size());

@@ -39,11 +39,11 @@ struct EpisodeResult {
   // hypotheses they weighed (summed over the frames).
   double unsure_s = 0;
   std::size_t unsure_frames = 0, unsure_hypotheses = 0;
-  std::string last_why;    // the localizer's last word when it never fixed
+  std::string last_why;  // the localizer's last word when it never fixed
 };
 
 struct BatteryOptions {
-  double speed = 0.5;             // m/s
+  double speed = 0.5;                       // m/s
   double ceiling_rate = 10, omni_rate = 1;  // Hz
   double ceiling_delay_s = 1.0, omni_delay_s = 0.5;
   double odometry_scale_sigma = 0.005;  // per wheel, drawn per episode

@@ -36,8 +36,9 @@ std::optional<GlobalMethod> parse_global_method(const std::string& name);
 // Alg. 3 as published. The paper gives neither the matching threshold nor the noise; ours are
 // noise of about the spacing of the 702 initial poses over the museum's regions (0.83 m) and a
 // threshold of 25 px, chosen among 15-40 px and 0.3-0.6 m on the simulated global run within
-// the 2 ms budget (docs/global-localization.md). The published count of 2502 evaluations is 702 + 6 x 300:
-// each iteration evaluates the 200 new poses with the best half of the particles they came from.
+// the 2 ms budget (docs/global-localization.md). The published count of 2502 evaluations is 702 + 6
+// x 300: each iteration evaluates the 200 new poses with the best half of the particles they came
+// from.
 struct PaperMethodOptions {
   int initial_poses = 702;
   int particles = 200;
@@ -107,8 +108,8 @@ struct GlobalLocalization {
   // Every place the votes point to was scored and every plausible hypothesis returned: the
   // true pose, if the image shows lamps of the map, is among the hypotheses.
   bool complete = false;
-  std::string why;         // why there is no hypothesis, or why it is ambiguous
-  int blobs = 0;           // detections used
+  std::string why;  // why there is no hypothesis, or why it is ambiguous
+  int blobs = 0;    // detections used
   int merit_evaluations = 0;
   bool found() const { return !hypotheses.empty(); }
 };

@@ -34,34 +34,34 @@
 namespace lampnav::fusion {
 
 struct HypothesisSetOptions {
-  double publish_posterior = 0.999;  // the leader's share of the weight needed to publish it
-  double publish_ratio = 1000;       // and its likelihood ratio over the runner-up
-  int min_omni_frames = 1;           // omni frames that weighed the set before it may publish
-  int max_hypotheses = 512;          // an image fitting more places leaves the set incomplete
-  int symmetry_check_max = 8;        // at most this many hypotheses are checked for twins
-  double drop_ratio = 1e-9;          // hypotheses below this likelihood ratio to the best die
-  double birth_ratio = 1e-4;         // an image gives birth to the places within this ratio of
-                                     // its best (the truth's own noise stays far inside it)
-  int refined = 1024;                // the likeliest, refined by least squares on each omni
-                                     // frame; the others are only scored (cheaper, but their
-                                     // costs are then less comparable)
-  double frame_cost_cap = 12.0;      // -2 ln L one omni frame can cost a hypothesis: one odd
-                                     // frame (a person under a lamp) never decides alone
-  double ceiling_cost_cap = 2.0;     // the same for a ceiling frame: ten a second see the same
-                                     // lamps, so their evidence is far from independent
-  double kept_prior = 0.1;           // the tracking hypothesis's prior after a kidnap alarm
+  double publish_posterior = 0.999;       // the leader's share of the weight needed to publish it
+  double publish_ratio = 1000;            // and its likelihood ratio over the runner-up
+  int min_omni_frames = 1;                // omni frames that weighed the set before it may publish
+  int max_hypotheses = 512;               // an image fitting more places leaves the set incomplete
+  int symmetry_check_max = 8;             // at most this many hypotheses are checked for twins
+  double drop_ratio = 1e-9;               // hypotheses below this likelihood ratio to the best die
+  double birth_ratio = 1e-4;              // an image gives birth to the places within this ratio of
+                                          // its best (the truth's own noise stays far inside it)
+  int refined = 1024;                     // the likeliest, refined by least squares on each omni
+                                          // frame; the others are only scored (cheaper, but their
+                                          // costs are then less comparable)
+  double frame_cost_cap = 12.0;           // -2 ln L one omni frame can cost a hypothesis: one odd
+                                          // frame (a person under a lamp) never decides alone
+  double ceiling_cost_cap = 2.0;          // the same for a ceiling frame: ten a second see the same
+                                          // lamps, so their evidence is far from independent
+  double kept_prior = 0.1;                // the tracking hypothesis's prior after a kidnap alarm
   double merge_m = 0.3, merge_deg = 5.0;  // hypotheses closer than this are one
   // Odometry error while carried: position sigma grows by sigma_per_m per metre travelled, yaw
   // by sigma_yaw_deg_per_m (deg per metre); the floor: sigma_m, sigma_yaw_deg.
   double sigma_m = 0.02, sigma_per_m = 0.03;
   double sigma_yaw_deg = 0.5, sigma_yaw_deg_per_m = 1.0;
-  double wall_margin_m = 0.4;    // a pose this far outside every region went through a wall
-  double omni_bump_sigma_m = 0.06;      // floor bumps added to an omni refinement's covariance
+  double wall_margin_m = 0.4;       // a pose this far outside every region went through a wall
+  double omni_bump_sigma_m = 0.06;  // floor bumps added to an omni refinement's covariance
   double omni_bump_sigma_deg = 0.15;
   double birth_sigma_m = 0.1, birth_sigma_deg = 1.5;  // a hypothesis born from one image
-  double ceiling_miss_cost = 4.6;       // -2 ln 0.1, a lamp in clear view not seen
-  double ceiling_spurious_cost = 6.0;   // a lamp in full view no map lamp explains
-  void validate() const;                // throws InputError naming the field
+  double ceiling_miss_cost = 4.6;                     // -2 ln 0.1, a lamp in clear view not seen
+  double ceiling_spurious_cost = 6.0;                 // a lamp in full view no map lamp explains
+  void validate() const;                              // throws InputError naming the field
 };
 
 enum class HypothesisOrigin { omni, kept };  // born from an omni image; the tracking estimate
@@ -73,10 +73,10 @@ struct Hypothesis {
   Stamp stamp;                                               // capture time it stands at
   Pose2 pose;                                                // robot base in the map, at stamp
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // x, y, yaw
-  Pose2 odometry;           // the dead-reckoned pose at stamp
-  double log_weight = 0;    // log prior + log likelihood of every frame since the set began
-  double weight = 0;        // posterior share (the set's weights sum to 1)
-  double last_cost = 0;     // -2 ln L of the last frame that weighed it
+  Pose2 odometry;                                            // the dead-reckoned pose at stamp
+  double log_weight = 0;      // log prior + log likelihood of every frame since the set began
+  double weight = 0;          // posterior share (the set's weights sum to 1)
+  double last_cost = 0;       // -2 ln L of the last frame that weighed it
   bool contradicted = false;  // the last frame plainly contradicted it (never published then)
   const graph::Node* node = nullptr;
 };

@@ -79,11 +79,13 @@ struct LocalizerEstimate {
   Pose2 pose;  // lost or ambiguous: the most likely hypothesis (or the last estimate), NOT a fix
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
   LocalizerMode mode = LocalizerMode::tracking;
-  const graph::Node* node = nullptr;  // the node whose region holds the pose, if any
+  const graph::Node* node = nullptr;     // the node whose region holds the pose, if any
   std::vector<WeightedPose> hypotheses;  // lost or ambiguous: every place it may be, best first
-  bool undecidable = false;  // ambiguous between symmetry twins: no motion can decide
-  std::string why;           // lost or ambiguous: why, in words
-  bool known() const { return mode == LocalizerMode::tracking || mode == LocalizerMode::relocalized; }
+  bool undecidable = false;              // ambiguous between symmetry twins: no motion can decide
+  std::string why;                       // lost or ambiguous: why, in words
+  bool known() const {
+    return mode == LocalizerMode::tracking || mode == LocalizerMode::relocalized;
+  }
 };
 
 struct LocalizerEvent {

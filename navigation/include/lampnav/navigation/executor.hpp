@@ -82,7 +82,7 @@ class Executor {
   std::size_t reached_ = 0;  // index in plan_.route.nodes of the last place entered
   const graph::Node* last_node_ = nullptr;
   std::optional<Stamp> lost_since_;
-  double explored_m_ = 0;              // driven while ambiguous since the loss
+  double explored_m_ = 0;               // driven while ambiguous since the loss
   std::optional<Stamp> explore_stamp_;  // the last exploring step
   double explore_v_ = 0;
   bool explore_noted_ = false;

@@ -18,10 +18,10 @@ struct BuildingOptions {
   double block_m = 20.0;         // junction spacing
   double lamp_spacing_m = 2.25;  // along corridors, as on the office floor
   double ceiling_m = 2.7;
-  bool rooms = true;          // rooms (seeded blocks) with their doors, to the node count
-  int missing_corridors = 0;  // corridors left out (seeded; the building stays connected)
+  bool rooms = true;               // rooms (seeded blocks) with their doors, to the node count
+  int missing_corridors = 0;       // corridors left out (seeded; the building stays connected)
   double wing_lamp_spacing_m = 0;  // > 0: corridors east of the middle have this spacing
-  bool lobby = false;  // a hall of round lamps south-west of the corner junction at the origin
+  bool lobby = false;      // a hall of round lamps south-west of the corner junction at the origin
   std::uint64_t seed = 1;  // which blocks get rooms, which corridors are missing
   void validate() const;   // throws InputError naming the field
 };
