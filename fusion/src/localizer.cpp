@@ -220,11 +220,16 @@ struct Localizer::Impl {
     }
     lose(monitor.ceiling(e));
   }
-  // A ceiling frame, through `process(pose, covariance)` (the pipeline on an image or on outside
-  // detections). While unsure, its lamps weigh every hypothesis (labelled from the likeliest
+  // A ceiling frame: an image, or the lamps an outside detector found in one (the pipeline
+  // takes either). While unsure, its lamps weigh every hypothesis (labelled from the likeliest
   // place only so that the tracker keeps going).
-  template <class Process>
-  const CeilingObservation& ceiling(Stamp stamp, Process process, Localizer& self) {
+  template <class Frame>
+  const CeilingObservation& ceiling(Stamp stamp, const Frame& frame, Localizer& self) {
+    if (!pipeline)
+      throw InputError({"", "robot.json", "cameras"}, "the robot has no ceiling_camera");
+    const auto process = [&](const Pose2& pose, const Eigen::Matrix3d& P) {
+      return pipeline->process(stamp, frame, pose, P);
+    };
     last_ceiling = CeilingObservation{};
     last_ceiling.stamp = stamp;
     const std::optional<FilterState> prior = self.prior_at(stamp);
@@ -308,28 +313,12 @@ std::optional<FilterState> Localizer::prior_at(Stamp stamp) const {
 }
 
 const CeilingObservation& Localizer::ceiling_frame(Stamp stamp, const vision::ImageView& image) {
-  Impl& m = *impl_;
-  if (!m.pipeline)
-    throw InputError({"", "robot.json", "cameras"}, "the robot has no ceiling_camera");
-  return m.ceiling(
-      stamp,
-      [&](const Pose2& pose, const Eigen::Matrix3d& P) {
-        return m.pipeline->process(stamp, image, pose, P);
-      },
-      *this);
+  return impl_->ceiling(stamp, image, *this);
 }
 
 const CeilingObservation& Localizer::ceiling_detections(
     Stamp stamp, const std::vector<vision::LampDetection>& lamps) {
-  Impl& m = *impl_;
-  if (!m.pipeline)
-    throw InputError({"", "robot.json", "cameras"}, "the robot has no ceiling_camera");
-  return m.ceiling(
-      stamp,
-      [&](const Pose2& pose, const Eigen::Matrix3d& P) {
-        return m.pipeline->process(stamp, lamps, pose, P);
-      },
-      *this);
+  return impl_->ceiling(stamp, lamps, *this);
 }
 
 void Localizer::ceiling_observation(const CeilingObservation& ob) {

@@ -6,11 +6,9 @@
 // Foxglove (the last open-source Studio's parseJsonSchema, still in Lichtblick) drops a topic whose
 // schema it cannot turn into fields: a `type` that is not one string (a union such as
 // ["string", "null"]), an object without `properties`, an array without `items`.
-import { McapIndexedReader } from "@mcap/core";
 import { createRequire } from "node:module";
-import { decompress } from "fzstd";
-import { open } from "node:fs/promises";
 import { isDeepStrictEqual } from "node:util";
+import { openMcap } from "./open_mcap.mjs";
 
 const official = createRequire(import.meta.url)("@foxglove/schemas/jsonschema");
 
@@ -63,20 +61,7 @@ function validate(schema, value, path) {
   if (t === "array") value.forEach((v, i) => validate(schema.items, v, `${path}[${i}]`));
 }
 
-const file = process.argv[2];
-const handle = await open(file, "r");
-const readable = {
-  size: async () => BigInt((await handle.stat()).size),
-  read: async (offset, size) => {
-    const buf = new Uint8Array(Number(size));
-    await handle.read(buf, 0, Number(size), Number(offset));
-    return buf;
-  },
-};
-const reader = await McapIndexedReader.Initialize({
-  readable,
-  decompressHandlers: { zstd: (buffer) => decompress(buffer) },
-});
+const { reader, close } = await openMcap(process.argv[2]);
 const report = {};
 let failed = false;
 const schemas = {};
@@ -112,6 +97,6 @@ for await (const msg of reader.readMessages()) {
     failed = true;
   }
 }
-await handle.close();
+await close();
 console.log(JSON.stringify(report));
 process.exit(failed ? 1 : 0);

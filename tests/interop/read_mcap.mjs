@@ -1,25 +1,14 @@
 // Reads an MCAP file with the official TypeScript reader (@mcap/core's indexed reader) and prints
 // what it found as JSON: profile, library, topics with schema and message counts, statistics,
 // attachments with sizes. Exits 1 with the reader's error if it refuses the file.
-import { McapIndexedReader } from "@mcap/core";
-import { decompress } from "fzstd";
-import { open } from "node:fs/promises";
+import { openMcap } from "./open_mcap.mjs";
 
 const path = process.argv[2];
-const handle = await open(path, "r");
-const readable = {
-  size: async () => BigInt((await handle.stat()).size),
-  read: async (offset, size) => {
-    const buf = new Uint8Array(Number(size));
-    await handle.read(buf, 0, Number(size), Number(offset));
-    return buf;
-  },
-};
+let close = async () => {};
 try {
-  const reader = await McapIndexedReader.Initialize({
-    readable,
-    decompressHandlers: { zstd: (buffer) => decompress(buffer) },
-  });
+  const opened = await openMcap(path);
+  close = opened.close;
+  const reader = opened.reader;
   const topics = {};
   for (const ch of reader.channelsById.values()) {
     topics[ch.topic] = {
@@ -56,5 +45,5 @@ try {
   console.error(`@mcap/core refused ${path}: ${err.message ?? err}`);
   process.exit(1);
 } finally {
-  await handle.close();
+  await close();
 }
