@@ -390,9 +390,12 @@ struct HypothesisSet::Impl {
       last_why.clear();
       return;
     }
+    // Shown for what they are (some of the places), weighed by this image alone.
     last_why = r.why.empty() ? "the image fits more places than were enumerated" : r.why;
     const double best = hs.empty() ? 0.0 : hs.front().log_weight;
-    for (std::size_t k = 0; k < n; ++k) hs.push_back(born(r.hypotheses[k], stamp, odo, best));
+    for (std::size_t k = 0; k < n; ++k)
+      hs.push_back(
+          born(r.hypotheses[k], stamp, odo, best - 0.5 * (r.hypotheses[k].score - best_score)));
   }
 
   void reset(const std::string& why) {
@@ -445,6 +448,13 @@ void HypothesisSet::omni(Stamp stamp, const vision::OmniDetection& d,
                          const OdometryTrack& odometry) {
   Impl& m = *impl_;
   if (!m.omni) return;
+  // While the places are not all known nothing can be published, so only the kept estimate is
+  // weighed; the others are born again from this image.
+  if (!m.complete)
+    m.hs.erase(
+        std::remove_if(m.hs.begin(), m.hs.end(),
+                       [](const Hypothesis& h) { return h.origin != HypothesisOrigin::kept; }),
+        m.hs.end());
   if (!m.hs.empty()) {
     // Best first: the likeliest are refined, the rest scored where they stand.
     int rank = 0;
@@ -468,7 +478,8 @@ void HypothesisSet::omni(Stamp stamp, const vision::OmniDetection& d,
 void HypothesisSet::ceiling(Stamp stamp, const std::vector<vision::LampDetection>& lamps,
                             const OdometryTrack& odometry) {
   Impl& m = *impl_;
-  if (!m.labeller || m.hs.empty()) return;
+  // Until the places are all known the omni frames do the weighing (see omni()).
+  if (!m.labeller || m.hs.empty() || !m.complete) return;
   m.weigh_all(stamp, odometry, m.o.ceiling_cost_cap,
               [&](Hypothesis& h) { return m.weigh_ceiling(h, lamps); });
   m.tidy();

@@ -109,9 +109,9 @@ class HypothesisSet {
   void keep(Stamp stamp, const Pose2& pose, const Eigen::Matrix3d& covariance,
             const OdometryTrack& odometry);
 
-  // One omni frame captured at `stamp`: every hypothesis weighed and refined, and new ones born
-  // from it while the set is incomplete. A frame that plainly contradicts every hypothesis
-  // starts the set again.
+  // One omni frame captured at `stamp`: every hypothesis weighed and refined. While the set is
+  // incomplete the hypotheses are born again from each image (only the kept estimate carries
+  // its weight over). A frame that plainly contradicts every hypothesis starts the set again.
   void omni(Stamp stamp, const vision::OmniDetection& detection, const OdometryTrack& odometry);
   // The lamps of one ceiling frame (full and completed views are used).
   void ceiling(Stamp stamp, const std::vector<vision::LampDetection>& lamps,
