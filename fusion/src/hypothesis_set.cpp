@@ -50,6 +50,8 @@ void HypothesisSetOptions::validate() const {
   check(birth_ratio >= drop_ratio && birth_ratio < 1, "birth_ratio", "must be in [drop_ratio, 1)");
   check(refined >= 0, "refined", "must not be negative");
   check(symmetry_check_max >= 2, "symmetry_check_max", "must be at least 2");
+  check(enumerate_every_m >= 0 && enumerate_every_deg >= 0, "enumerate_every_m",
+        "must not be negative");
   check(frame_cost_cap > 0, "frame_cost_cap", "must be positive");
   check(ceiling_cost_cap > 0, "ceiling_cost_cap", "must be positive");
   check(birth_sigma_m > 0 && birth_sigma_deg > 0, "birth_sigma_m", "must be positive");
@@ -80,7 +82,8 @@ struct HypothesisSet::Impl {
   int next_id = 1;
   std::string last_why = "no omni image yet";
   Counts counts;
-  mutable std::map<std::pair<int, int>, bool> twin_cache;  // by hypothesis ids
+  std::optional<std::pair<Stamp, Pose2>> last_enumeration;  // capture, dead-reckoned pose
+  mutable std::map<std::pair<int, int>, bool> twin_cache;   // by hypothesis ids
 
   // Whether the rigid motion taking pose a to pose b maps every lamp of the map onto a lamp of
   // the same shape and size (a rectangle's axis modulo a half turn): then the two places look
@@ -358,6 +361,7 @@ struct HypothesisSet::Impl {
   // what this image said of it, capped); an incomplete one only adds what is new, at the best
   // weight (it was not weighed on earlier frames).
   void births(Stamp stamp, const vision::OmniDetection& d, const OdometryTrack& odo) {
+    last_enumeration = {stamp, odo.at(stamp)};
     ++counts.enumerations;
     const double margin = -2 * std::log(o.birth_ratio);
     const GlobalLocalization r = omni->enumerate(d, o.max_hypotheses, margin);
@@ -386,6 +390,7 @@ struct HypothesisSet::Impl {
             born(r.hypotheses[k], stamp, odo, each - 0.5 * (r.hypotheses[k].score - best_score)));
       hs = std::move(next);
       complete = true;
+      last_enumeration.reset();
       omni_frames = 1;  // this image weighed them
       last_why.clear();
       return;
@@ -398,8 +403,18 @@ struct HypothesisSet::Impl {
           born(r.hypotheses[k], stamp, odo, best - 0.5 * (r.hypotheses[k].score - best_score)));
   }
 
+  // Whether an incomplete set should enumerate this image: the first after a loss, then once the
+  // robot has moved on enough for the view to fit other places.
+  bool enumeration_due(Stamp stamp, const OdometryTrack& odo) const {
+    if (!last_enumeration || hs.empty()) return true;
+    const Pose2 moved = last_enumeration->second.between(odo.at(stamp));
+    return odo.travel(last_enumeration->first, stamp) >= o.enumerate_every_m ||
+           std::abs(moved.yaw()) >= o.enumerate_every_deg * kDeg;
+  }
+
   void reset(const std::string& why) {
     ++counts.resets;
+    last_enumeration.reset();
     hs.clear();
     complete = false;
     omni_frames = 0;
@@ -421,6 +436,7 @@ void HypothesisSet::clear() {
   m.complete = false;
   m.omni_frames = 0;
   m.twin_cache.clear();
+  m.last_enumeration.reset();
   m.last_why = "no omni image yet";
 }
 
@@ -449,7 +465,8 @@ void HypothesisSet::omni(Stamp stamp, const vision::OmniDetection& d,
   Impl& m = *impl_;
   if (!m.omni) return;
   // While the places are not all known nothing can be published, so only the kept estimate is
-  // weighed; the others are born again from this image.
+  // weighed; the others are born again from this image, when the robot has moved on enough.
+  if (!m.complete && !m.enumeration_due(stamp, odometry)) return;
   if (!m.complete)
     m.hs.erase(
         std::remove_if(m.hs.begin(), m.hs.end(),
