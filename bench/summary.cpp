@@ -248,10 +248,10 @@ int main(int argc, char** argv) {
     add_counter(std::string("replay of a 10-minute mission, ") + n + "-node building",
                 std::string("BM_ReplayBuildingMission/") + n, "realtime_factor", 50, "x real time");
   grows("replay", "BM_ReplayBuildingMission");
-  for (const auto& [n, count] : {std::pair{"10", "100"}, {"100", "100"}, {"1000", "1"}})
+  for (const auto& [n, count] : {std::pair{"10", "100"}, {"100", "100"}, {"1000", "10"}})
     add_battery(std::string("kidnaps (") + count + "), " + n + "-node building",
                 std::string("BM_KidnapBattery/") + n + "/" + count, true);
-  for (const auto& [n, count] : {std::pair{"10", "20"}, {"100", "20"}, {"1000", "1"}})
+  for (const auto& [n, count] : {std::pair{"10", "20"}, {"100", "20"}, {"1000", "3"}})
     add_battery(std::string("unknown starts (") + count + "), " + n + "-node building",
                 std::string("BM_UnknownStartBattery/") + n + "/" + count, false);
 
