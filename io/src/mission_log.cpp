@@ -168,6 +168,7 @@ std::vector<ChannelSpec> channel_specs() {
        R"({"type": "object", "properties": {)" + t +
            R"(, "camera": {"type": "string"}, "lamps": {"type": "array", "items": {"type": "object", "properties": {"u": {"type": "number"}, "v": {"type": "number"}, "orientation": {"type": "number"}, "area": {"type": "number"}, "track": {"type": "integer"}, "label": {"type": "string"}}}}}})"},
       {topics::kScene, "foxglove.SceneUpdate", foxglove_schemas::kSceneUpdate},
+      {topics::kLog, "foxglove.Log", foxglove_schemas::kLog},
   };
 }
 
@@ -280,6 +281,16 @@ void MissionLogWriter::write(Stamp available, const Hypotheses& h) {
                     {"node", e.node}});
   impl_->put(topics::kHypotheses, available, h.stamp,
              Json{{"timestamp", stamp_json(h.stamp)}, {"mode", h.mode}, {"hypotheses", list}});
+}
+
+void MissionLogWriter::write(Stamp available, const LogMessage& m) {
+  impl_->put(topics::kLog, available, m.stamp,
+             Json{{"timestamp", stamp_json(m.stamp)},
+                  {"level", static_cast<int>(m.level)},
+                  {"message", m.message},
+                  {"name", m.name},
+                  {"file", ""},
+                  {"line", 0}});
 }
 
 void MissionLogWriter::write(Stamp available, const SceneUpdate& u) {

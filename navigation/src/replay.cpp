@@ -410,6 +410,15 @@ void write_replay(const ReplayResult& r, const io::MissionLog& log,
       w.write(e.stamp, p);
     }
     for (const auto& f : r.lamp_frames) w.write(f.arrival, f.observations);
+    // The replay's notes, for people, at the start of the log.
+    const Stamp first = log.wheels.empty() ? Stamp{} : log.wheels.front().value.stamp;
+    for (const auto& n : r.notes) {
+      const bool warn = n.rfind("skipped", 0) == 0 || n.find("truncated") != std::string::npos ||
+                        n.find("never localized") != std::string::npos;
+      w.write(first, io::LogMessage{
+                         first, warn ? io::LogMessage::Level::warning : io::LogMessage::Level::info,
+                         n, "lampnav replay"});
+    }
     for (const auto& h : r.hypotheses) {
       io::Hypotheses msg;
       msg.stamp = h.stamp;

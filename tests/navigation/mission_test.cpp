@@ -125,8 +125,9 @@ void replay_writes_the_outputs(const Driven& d) {
                             "' && node check_schemas.mjs '" + out + "/replay.mcap' 2>&1",
                         &status);
   EXPECT_EQ(status, 0) << checked;
-  for (const char* topic : {"/truth/pose", "/lampnav/pose", "/lampnav/scene", "/lampnav/estimate",
-                            "/lampnav/lamps", "/lampnav/hypotheses", "/ceiling_camera/image"})
+  for (const char* topic :
+       {"/truth/pose", "/lampnav/pose", "/lampnav/scene", "/lampnav/estimate", "/lampnav/lamps",
+        "/lampnav/hypotheses", "/ceiling_camera/image", "/lampnav/log"})
     EXPECT_NE(checked.find(std::string("\"") + topic + "\""), std::string::npos) << topic;
   // The replay log reads back with the inputs and the estimates.
   const io::MissionLog back = io::read_mission_log(out + "/replay.mcap");

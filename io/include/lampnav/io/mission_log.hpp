@@ -30,6 +30,7 @@ inline constexpr const char* kEstimate = "/lampnav/estimate";
 inline constexpr const char* kLamps = "/lampnav/lamps";
 inline constexpr const char* kScene = "/lampnav/scene";
 inline constexpr const char* kHypotheses = "/lampnav/hypotheses";
+inline constexpr const char* kLog = "/lampnav/log";
 }  // namespace topics
 
 struct WheelReading {
@@ -67,6 +68,15 @@ struct PoseEstimate {
   std::array<double, 9> covariance{};  // row-major, x y yaw
   std::string node;                    // "" when in no region
   std::string mode;                    // "tracking", "lost", "relocalized", "ambiguous"
+};
+
+// A line a person reads (/lampnav/log, foxglove.Log): what a replay used, missed or skipped.
+struct LogMessage {
+  enum class Level { debug = 1, info = 2, warning = 3, error = 4 };
+  Stamp stamp;
+  Level level = Level::info;
+  std::string message;
+  std::string name;  // who says it ("lampnav replay")
 };
 
 // Every place the robot may be while it does not know (/lampnav/hypotheses), with its weight.
@@ -149,6 +159,7 @@ class MissionLogWriter {
   void write(Stamp available, const PoseEstimate& e);
   void write(Stamp available, const LampObservations& o);
   void write(Stamp available, const Hypotheses& h);
+  void write(Stamp available, const LogMessage& m);
   void write(Stamp available, const SceneUpdate& u);
   void close();
 
