@@ -88,8 +88,14 @@ Lamp read_lamp(const Cursor& c, const Node& owner) {
   return l;
 }
 
-Node read_node(const Cursor& feature, const Cursor& props) {
-  props.only_keys({"id", "frame", "metadata"});
+// Format 1 keeps lamps, doors and the axis (as [[x, y], [x, y]]) in `metadata`; format 2 keeps
+// lamps and doors in `properties.lampnav` (which Nav2 ignores) and the axis as x_values/y_values
+// (which Nav2's loader can convert). map-format.md.
+Node read_node(const Cursor& feature, const Cursor& props, int format) {
+  if (format == 1)
+    props.only_keys({"id", "frame", "metadata"});
+  else
+    props.only_keys({"id", "frame", "metadata", "lampnav"});
   Node n;
   n.id = NodeId(props.at("id").integer());
   if (auto frame = props.find("frame")) {
@@ -101,7 +107,17 @@ Node read_node(const Cursor& feature, const Cursor& props) {
   n.point = read_xy(geom.at("coordinates"));
 
   const Cursor md = props.at("metadata");
-  md.only_keys({"name", "place", "axis", "width", "region", "doors", "lamps", "length"});
+  if (format == 1)
+    md.only_keys({"name", "place", "axis", "width", "region", "doors", "lamps", "length"});
+  else
+    md.only_keys({"name", "place", "axis", "width", "region", "length"});
+  std::optional<Cursor> extra;  // where lamps and doors are
+  if (format == 1) {
+    extra = md;
+  } else if (auto ln = props.find("lampnav")) {
+    ln->only_keys({"lamps", "doors"});
+    extra = *ln;
+  }
   n.name = md.at("name").string();
   const Cursor place = md.at("place");
   const auto kind = place_from_string(place.string());
@@ -112,15 +128,23 @@ Node read_node(const Cursor& feature, const Cursor& props) {
   n.place = *kind;
   n.region = read_region(md.at("region"));
   if (auto axis = md.find("axis")) {
-    axis->array_size(2, 2);
-    n.axis = Axis{read_xy((*axis)[0]), read_xy((*axis)[1])};
+    if (format == 1) {
+      axis->array_size(2, 2);
+      n.axis = Axis{read_xy((*axis)[0]), read_xy((*axis)[1])};
+    } else {
+      axis->only_keys({"x_values", "y_values"});
+      const Cursor xs = axis->at("x_values"), ys = axis->at("y_values");
+      xs.array_size(2, 2);
+      ys.array_size(2, 2);
+      n.axis = Axis{{xs[0].number(), ys[0].number()}, {xs[1].number(), ys[1].number()}};
+    }
     if (n.axis->length() < 1e-6) axis->fail("axis has zero length");
   } else if (n.place == Place::corridor) {
     md.at("axis");  // throws "missing": a corridor needs its centreline
   }
   if (auto width = md.find("width")) n.width = width->positive();
   if (auto length = md.find("length")) n.length_override = length->positive();
-  if (auto doors = md.find("doors")) {
+  if (auto doors = extra ? extra->find("doors") : std::nullopt) {
     const std::size_t count = doors->array_size();
     if (count > 0 && !n.axis) doors->fail("doors are placed along an axis; this node has none");
     std::set<std::string> names;
@@ -146,7 +170,7 @@ Node read_node(const Cursor& feature, const Cursor& props) {
       n.doors.push_back(std::move(door));
     }
   }
-  if (auto lamps = md.find("lamps")) {
+  if (auto lamps = extra ? extra->find("lamps") : std::nullopt) {
     const std::size_t count = lamps->array_size();
     for (std::size_t i = 0; i < count; ++i) n.lamps.push_back(read_lamp((*lamps)[i], n));
   }
@@ -209,10 +233,12 @@ LoadedMap parse_map(const std::string& text, const std::string& source) {
   const Cursor ln = root.at("lampnav");
   ln.only_keys({"format", "units", "frame"});
   const Cursor format = ln.at("format");
-  if (!format.value().is_number_integer() || format.value().get<std::int64_t>() != kMapFormat) {
-    format.fail("unknown map format " + format.value().dump() + " (this reader knows format " +
-                std::to_string(kMapFormat) + ")");
+  if (!format.value().is_number_integer() ||
+      (format.value().get<std::int64_t>() != 1 && format.value().get<std::int64_t>() != 2)) {
+    format.fail("unknown map format " + format.value().dump() +
+                " (this reader knows formats 1 and 2)");
   }
+  const int map_format = static_cast<int>(format.value().get<std::int64_t>());
   if (auto units = ln.find("units")) {
     if (units->string() != "m") units->fail("units must be \"m\"");
   }
@@ -242,7 +268,7 @@ LoadedMap parse_map(const std::string& text, const std::string& source) {
       pf.place = where.place;
       if (gtype == "Point") {
         pf.is_node = true;
-        pf.node = read_node(f, props);
+        pf.node = read_node(f, props, map_format);
       } else if (gtype == "MultiLineString") {
         pf.edge = read_edge(f, props);
       } else {

@@ -1,4 +1,5 @@
 #include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/graph/geojson.hpp"
@@ -47,7 +48,7 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(
         Refusal{"not_json", "line 3, column 17", "", "not valid JSON"},
         Refusal{"not_feature_collection", "", "type", "not a GeoJSON FeatureCollection"},
-        Refusal{"unknown_format", "", "lampnav.format", "unknown map format 2"},
+        Refusal{"unknown_format", "", "lampnav.format", "unknown map format 3"},
         Refusal{"missing_format", "", "lampnav.format", "missing"},
         Refusal{"duplicate_id", "features[3] (id 1)", "properties.id", "duplicate id 1"},
         Refusal{"duplicate_name", "features[1] (id 2)", "properties.metadata.name",
@@ -174,6 +175,77 @@ TEST_P(RoundTrip, WriteReadIsIdentity) {
 INSTANTIATE_TEST_SUITE_P(BundledMaps, RoundTrip,
                          ::testing::Values("maps/office_floor.geojson", "maps/domus_museum.geojson",
                                            "tests/fixtures/maps/valid_tiny.geojson"));
+
+}  // namespace
+}  // namespace lampnav::graph
+
+namespace lampnav::graph {
+namespace {
+
+// Format 2 (map-format.md): lamps and doors under properties.lampnav, the axis as x_values and
+// y_values. The same map in either format reads the same.
+nlohmann::json to_format_2(nlohmann::json doc) {
+  doc["lampnav"]["format"] = 2;
+  for (auto& f : doc["features"]) {
+    auto& props = f["properties"];
+    if (!props.contains("metadata")) continue;
+    auto& md = props["metadata"];
+    nlohmann::json ln = nlohmann::json::object();
+    for (const char* k : {"lamps", "doors"})
+      if (md.contains(k)) {
+        ln[k] = md[k];
+        md.erase(k);
+      }
+    if (!ln.empty()) props["lampnav"] = ln;
+    if (md.contains("axis")) {
+      const auto a = md["axis"];
+      md["axis"] = {{"x_values", {a[0][0], a[1][0]}}, {"y_values", {a[0][1], a[1][1]}}};
+    }
+  }
+  return doc;
+}
+
+TEST(MapReader, ReadsFormat2AsFormat1) {
+  for (const char* file : {"maps/office_floor.geojson", "maps/domus_museum.geojson"}) {
+    const std::string text = test::slurp(test::source_path(file));
+    const TopologicalMap one = parse_map(text, file).map;
+    const std::string two_text = to_format_2(nlohmann::json::parse(text)).dump();
+    const TopologicalMap two = parse_map(two_text, "format 2").map;
+    ASSERT_EQ(one.node_count(), two.node_count()) << file;
+    ASSERT_EQ(one.edge_count(), two.edge_count());
+    ASSERT_EQ(one.lamp_count(), two.lamp_count());
+    EXPECT_GT(two.lamp_count(), 0u);
+    for (std::size_t i = 0; i < one.node_count(); ++i) {
+      const Node &a = one.node_at_index(i), &b = two.node_at_index(i);
+      EXPECT_EQ(a.name, b.name);
+      ASSERT_EQ(a.axis.has_value(), b.axis.has_value()) << a.name;
+      if (a.axis) {
+        EXPECT_EQ(a.axis->first, b.axis->first);
+        EXPECT_EQ(a.axis->second, b.axis->second);
+      }
+      ASSERT_EQ(a.lamps.size(), b.lamps.size()) << a.name;
+      for (std::size_t k = 0; k < a.lamps.size(); ++k) {
+        EXPECT_EQ(a.lamps[k].id, b.lamps[k].id);
+        EXPECT_EQ(a.lamps[k].xyz, b.lamps[k].xyz);
+      }
+      EXPECT_EQ(a.doors.size(), b.doors.size()) << a.name;
+    }
+  }
+}
+
+TEST(MapReader, Format2RefusesLampsInMetadata) {
+  const std::string text = test::slurp(test::source_path("maps/office_floor.geojson"));
+  nlohmann::json doc = nlohmann::json::parse(text);
+  doc["lampnav"]["format"] = 2;  // lamps still in metadata, where Nav2's loader throws
+  try {
+    parse_map(doc.dump(), "m.geojson");
+    FAIL() << "accepted";
+  } catch (const InputErrors& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr("lamps"));
+  } catch (const InputError& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr("lamps"));
+  }
+}
 
 }  // namespace
 }  // namespace lampnav::graph

@@ -22,7 +22,7 @@ struct LoadedMap {
   std::vector<MapWarning> warnings;  // check_map() with default options
 };
 
-// The map format versions this reader knows.
+// The map format the writer writes (the reader reads formats 1 and 2: map-format.md).
 constexpr int kMapFormat = 1;
 // Regions may touch; they may overlap by at most this area before the map is refused (m^2).
 constexpr double kRegionOverlapTolerance = 0.01;
