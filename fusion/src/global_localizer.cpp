@@ -55,8 +55,6 @@ void GlobalLocalizerOptions::validate() const {
   check(q.distinct_m > 0 && q.distinct_deg > 0, "pairs.distinct_m", "must be positive");
   check(q.candidates >= 1 && q.refined >= 1 && q.refined <= q.candidates, "pairs.candidates",
         "must be positive, with refined <= candidates");
-  check(q.complete_vote_fraction > 0 && q.complete_vote_fraction <= 1,
-        "pairs.complete_vote_fraction", "must be in (0, 1]");
   check(max_hypotheses >= 1, "max_hypotheses", "must be positive");
 }
 

@@ -48,7 +48,6 @@ void HypothesisSetOptions::validate() const {
   check(max_hypotheses >= 1 && max_hypotheses <= 100000, "max_hypotheses", "must be 1 to 100000");
   check(drop_ratio > 0 && drop_ratio < 1e-3, "drop_ratio", "must be in (0, 0.001)");
   check(birth_ratio >= drop_ratio && birth_ratio < 1, "birth_ratio", "must be in [drop_ratio, 1)");
-  check(refined >= 0, "refined", "must not be negative");
   check(symmetry_check_max >= 2, "symmetry_check_max", "must be at least 2");
   check(enumerate_every_m >= 0 && enumerate_every_deg >= 0, "enumerate_every_m",
         "must not be negative");
@@ -207,11 +206,11 @@ struct HypothesisSet::Impl {
     return (expected >= 3 && 2 * missing > expected) || (seen >= 4 && 2 * unexplained > seen);
   }
 
-  // An omni frame for one hypothesis (carried to the frame), updating it when `refine`.
-  Weighed weigh_omni(Hypothesis& h, const vision::OmniDetection& d, bool refine) const {
+  // An omni frame for one hypothesis (carried to the frame), updating it.
+  Weighed weigh_omni(Hypothesis& h, const vision::OmniDetection& d) const {
     const double ps = std::clamp(sigma_position(h.covariance), 0.03, 1.5);
     const double ys = std::clamp(std::sqrt(h.covariance(2, 2)), 0.5 * kDeg, 15 * kDeg);
-    const std::optional<PoseHypothesis> r = refine ? omni->refine(h.pose, ps, ys, d) : std::nullopt;
+    const std::optional<PoseHypothesis> r = omni->refine(h.pose, ps, ys, d);
     if (r && r->matches.size() >= 2) {
       Eigen::Matrix3d R = r->covariance;
       R.diagonal() += Eigen::Vector3d(o.omni_bump_sigma_m * o.omni_bump_sigma_m,
@@ -225,11 +224,6 @@ struct HypothesisSet::Impl {
     const GlobalLocalizer::PoseScore sc = omni->score(h.pose, ps, ys, d);
     return {sc.cost,
             contradicts(sc.expected, sc.missing, sc.matched + sc.unexplained, sc.unexplained)};
-  }
-
-  // Map lamps the hypothesis puts well inside the ceiling view with nothing detected near.
-  int missing(const std::vector<vision::LampDetection>& lamps, const Hypothesis& h) const {
-    return unseen_lamps(*map, *camera, *geometry, lamps, h.pose, h.covariance);
   }
 
   // A ceiling frame for one hypothesis (carried to the frame), updating it.
@@ -248,7 +242,9 @@ struct HypothesisSet::Impl {
       }
     }
     double cost = o.ceiling_spurious_cost * unexplained;
-    if (!lamps.empty()) cost += o.ceiling_miss_cost * missing(lamps, h);
+    if (!lamps.empty())  // a dark frame says nothing of missing lamps
+      cost +=
+          o.ceiling_miss_cost * unseen_lamps(*map, *camera, *geometry, lamps, h.pose, h.covariance);
     if (!labelled.empty()) {
       PoseRefusal refusal = PoseRefusal::none;
       const std::optional<PoseMeasurement> m =
@@ -358,8 +354,8 @@ struct HypothesisSet::Impl {
 
   // Births from one image's enumeration. A complete one starts the set again from every place
   // it found, weighed by the image (the kept estimate, if still alive, keeps its prior share and
-  // what this image said of it, capped); an incomplete one only adds what is new, at the best
-  // weight (it was not weighed on earlier frames).
+  // what this image said of it, capped); an incomplete one shows the places found, weighed by
+  // this image alone, beside the kept estimate (omni() removed the previous image's).
   void births(Stamp stamp, const vision::OmniDetection& d, const OdometryTrack& odo) {
     last_enumeration = {stamp, odo.at(stamp)};
     ++counts.enumerations;
@@ -395,12 +391,9 @@ struct HypothesisSet::Impl {
       last_why.clear();
       return;
     }
-    // Shown for what they are (some of the places), weighed by this image alone.
     last_why = r.why.empty() ? "the image fits more places than were enumerated" : r.why;
-    const double best = hs.empty() ? 0.0 : hs.front().log_weight;
     for (std::size_t k = 0; k < n; ++k)
-      hs.push_back(
-          born(r.hypotheses[k], stamp, odo, best - 0.5 * (r.hypotheses[k].score - best_score)));
+      hs.push_back(born(r.hypotheses[k], stamp, odo, -0.5 * (r.hypotheses[k].score - best_score)));
   }
 
   // Whether an incomplete set should enumerate this image: the first after a loss, then once the
@@ -473,11 +466,8 @@ void HypothesisSet::omni(Stamp stamp, const vision::OmniDetection& d,
                        [](const Hypothesis& h) { return h.origin != HypothesisOrigin::kept; }),
         m.hs.end());
   if (!m.hs.empty()) {
-    // Best first: the likeliest are refined, the rest scored where they stand.
-    int rank = 0;
-    const bool all_contradicted =
-        m.weigh_all(stamp, odometry, m.o.frame_cost_cap,
-                    [&](Hypothesis& h) { return m.weigh_omni(h, d, rank++ < m.o.refined); });
+    const bool all_contradicted = m.weigh_all(stamp, odometry, m.o.frame_cost_cap,
+                                              [&](Hypothesis& h) { return m.weigh_omni(h, d); });
     if (m.complete) ++m.omni_frames;
     m.tidy();
     // Every hypothesis contradicted: the robot is none of them (carried away again, or the set

@@ -139,12 +139,11 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
                         pose);
   }
   // On a regular ceiling many places get the most votes alike (the lamps near the axis repeat);
-  // when more of them than could be scored reach the top votes (or the given fraction of them),
-  // the search did not see them all, and says so.
+  // when more of them reach the top votes than could be scored, the search did not see them all,
+  // and says so.
   std::size_t tied = 0;
   const int top_votes = voted.empty() ? 0 : voted.front().first;
-  const int enough = std::max(1, int(std::ceil(q.complete_vote_fraction * top_votes - 1e-9)));
-  for (const auto& rv : ranked) tied += rv.first >= enough ? 1 : 0;
+  for (const auto& rv : ranked) tied += rv.first == top_votes ? 1 : 0;
   const bool truncated = !scored.empty() && tied > handled;
   out.merit_evaluations = static_cast<int>(scored.size());
   if (scored.empty()) {

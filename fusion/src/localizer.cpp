@@ -99,7 +99,7 @@ struct Localizer::Impl {
     if (ekf.initialized()) return ekf.stamp();
     return odometry.empty() ? Stamp{} : odometry.last_stamp();
   }
-  bool unsure() const { return mode == LocalizerMode::lost || mode == LocalizerMode::ambiguous; }
+  bool unsure() const { return !is_certain(mode); }
 
   void set_mode(LocalizerMode m, const std::string& why) {
     if (m == mode) return;
@@ -124,12 +124,17 @@ struct Localizer::Impl {
 
   // After a frame weighed the hypotheses: a fix when one holds the evidence, else the mode says
   // whether the places the robot may be are all known (ambiguous) or not (lost).
-  void settle(Stamp stamp, Localizer& self) {
+  // The relocalization status from the hypothesis set as it stands.
+  void refresh_status() {
     relocalization.verdict = hypotheses->verdict();
     relocalization.why = hypotheses->why();
     relocalization.hypotheses.clear();
     for (const Hypothesis& h : hypotheses->hypotheses())
       relocalization.hypotheses.push_back({h.pose, h.covariance, h.weight, h.node});
+  }
+
+  void settle(Stamp stamp, Localizer& self) {
+    refresh_status();
     if (const Hypothesis* w = hypotheses->winner()) {
       // Carried to the newest odometry, so the fix is inside the filter's history.
       const Stamp at = odometry.empty() ? stamp : std::max(stamp, odometry.last_stamp());
@@ -176,6 +181,7 @@ struct Localizer::Impl {
     // The estimate tracked until now stays one of the places the robot may be: a false alarm
     // then costs a few frames, never the pose.
     if (ekf.initialized()) hypotheses->keep(ekf.stamp(), ekf.pose(), ekf.covariance(), odometry);
+    refresh_status();  // not the last loss's verdict
     set_mode(LocalizerMode::lost, *why);
   }
 

@@ -213,8 +213,7 @@ void score(ReplayResult& r, const io::MissionLog& log) {
   }
   bool wrong = false;
   for (const auto& e : r.estimates) {
-    const bool certain =
-        e.mode == fusion::LocalizerMode::tracking || e.mode == fusion::LocalizerMode::relocalized;
+    const bool certain = fusion::is_certain(e.mode);
     bool excused = false;
     for (const auto& [from, to] : unnoticed)
       if (e.stamp >= from && e.stamp <= to) excused = true;  // an estimate at the instant of
@@ -271,10 +270,8 @@ ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
     if (e.reason != "initialized") r.events.push_back(e);
   // Wheels alone, from the first pose the stack had.
   const auto known =
-      std::find_if(r.estimates.begin(), r.estimates.end(), [](const EstimateSample& e) {
-        return e.mode == fusion::LocalizerMode::tracking ||
-               e.mode == fusion::LocalizerMode::relocalized;
-      });
+      std::find_if(r.estimates.begin(), r.estimates.end(),
+                   [](const EstimateSample& e) { return fusion::is_certain(e.mode); });
   if (known != r.estimates.end()) {
     const Stamp from = known->stamp;
     fusion::StateVector x = known->pose.vector();

@@ -245,9 +245,7 @@ std::string map_figure(const graph::TopologicalMap& map, const std::vector<Serie
   return s.str();
 }
 
-bool unsure(fusion::LocalizerMode m) {
-  return m == fusion::LocalizerMode::lost || m == fusion::LocalizerMode::ambiguous;
-}
+bool unsure(fusion::LocalizerMode m) { return !fusion::is_certain(m); }
 
 // Stretches lost (red) and ambiguous (orange).
 std::vector<Interval> lost_intervals(const ReplayResult& r, double t0) {

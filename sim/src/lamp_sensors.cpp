@@ -37,11 +37,12 @@ Matrix3d bump(double sigma, std::mt19937_64& rng) {
 }  // namespace
 
 void LampSensorOptions::validate() const {
-  auto check = [](bool ok, const char* field) {
-    if (!ok) throw InputError({"", "lamp sensors", field}, "must not be negative");
+  auto check = [](bool ok, const char* field, const char* what = "must not be negative") {
+    if (!ok) throw InputError({"", "lamp sensors", field}, what);
   };
   check(omni_sigma_deg >= 0, "omni_sigma_deg");
-  check(omni_max_theta_deg > 0 && omni_max_theta_deg < 180, "omni_max_theta_deg");
+  check(omni_max_theta_deg > 0 && omni_max_theta_deg < 180, "omni_max_theta_deg",
+        "must be between 0 and 180 degrees");
   check(ceiling_sigma_px >= 0, "ceiling_sigma_px");
   check(ceiling_orientation_sigma >= 0, "ceiling_orientation_sigma");
   check(bump_sigma_deg >= 0, "bump_sigma_deg");

@@ -17,10 +17,6 @@ namespace {
 using Eigen::Vector2d;
 constexpr double kDeg = M_PI / 180.0;
 
-bool known(fusion::LocalizerMode m) {
-  return m == fusion::LocalizerMode::tracking || m == fusion::LocalizerMode::relocalized;
-}
-
 // Where a person at the joystick goes: along the corridor the robot stands in, towards the end
 // it faces, then by the planned route to a junction drawn at random, and so on.
 class Driver {
@@ -147,7 +143,6 @@ struct Battery::Impl {
       loc.initialize(stamp(0), truth, Eigen::Vector3d(1e-4, 1e-4, 3e-4).asDiagonal());
     std::optional<double> kidnapped_at, kidnap_travel, detected_at, fixed_at;
     bool wrong = false;
-    std::optional<fusion::LocalizerMode> mode;
     while (true) {
       // Truth and wheels.
       const auto [v, w] = driver.command(truth, o.speed);
@@ -179,7 +174,7 @@ struct Battery::Impl {
                        [](const Pending& a, const Pending& c) { return a.at < c.at; });
       while (!pending.empty() && pending.front().at <= t) {
         const Pending& p = pending.front();
-        const bool was_unsure = !known(loc.mode());
+        const bool was_unsure = !fusion::is_certain(loc.mode());
         const std::size_t live = loc.hypotheses().hypotheses().size();
         const auto t0 = std::chrono::steady_clock::now();
         if (p.ceiling)
@@ -214,7 +209,7 @@ struct Battery::Impl {
       const bool excused = kidnap_at_m && kidnapped_at && !detected_at && t - *kidnapped_at < 10;
       const double err = (e.pose.translation() - truth.translation()).norm();
       const double yaw_err = std::abs(wrap_angle(e.pose.yaw() - truth.yaw()));
-      const bool certain = loc.initialized() && known(e.mode);
+      const bool certain = loc.initialized() && e.known();
       const bool off = certain && !excused && err > 0.5;
       if (off && !wrong) ++r.wrong_fixes;
       wrong = off;
@@ -228,7 +223,6 @@ struct Battery::Impl {
         r.latency_s = t - from_t;
         r.latency_m = travel - kidnap_travel.value_or(0.0);
       }
-      mode = e.mode;
       const double since = travel - kidnap_travel.value_or(0.0);
       if (fixed_at && t - *fixed_at > o.after_fix_s) break;
       if ((!kidnap_at_m || kidnapped_at) && since > o.max_travel_m) break;

@@ -68,9 +68,6 @@ struct LampPairOptions {
   int candidates = 48;            // hypotheses scored after voting
   int refined = 12;               // of those, refined by least squares
   bool restrict_to_graph = true;  // a pose must lie in a node's region
-  // Cells with at least this fraction of the top votes must all be scored for the search to call
-  // itself complete (GlobalLocalization::complete).
-  double complete_vote_fraction = 1.0;
 };
 
 struct GlobalLocalizerOptions {

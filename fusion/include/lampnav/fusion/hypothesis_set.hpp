@@ -40,14 +40,11 @@ struct HypothesisSetOptions {
   int max_hypotheses = 512;          // an image fitting more places leaves the set incomplete
   int symmetry_check_max = 8;        // at most this many hypotheses are checked for twins
   // While the set is incomplete, the next enumeration waits for this much travel (m) or turn
-  // (deg): a view a metre on fits the same places, and enumerating costs 0.2 to 0.7 s.
+  // (deg): a view a metre on fits the same places, and enumerating costs up to 0.7 s.
   double enumerate_every_m = 2.0, enumerate_every_deg = 30.0;
   double drop_ratio = 1e-9;               // hypotheses below this likelihood ratio to the best die
   double birth_ratio = 1e-4;              // an image gives birth to the places within this ratio of
                                           // its best (the truth's own noise stays far inside it)
-  int refined = 1024;                     // the likeliest, refined by least squares on each omni
-                                          // frame; the others are only scored (cheaper, but their
-                                          // costs are then less comparable)
   double frame_cost_cap = 12.0;           // -2 ln L one omni frame can cost a hypothesis: one odd
                                           // frame (a person under a lamp) never decides alone
   double ceiling_cost_cap = 2.0;          // the same for a ceiling frame: ten a second see the same

@@ -41,6 +41,11 @@ namespace lampnav::fusion {
 
 enum class LocalizerMode { tracking, lost, relocalized, ambiguous };
 const char* to_string(LocalizerMode mode);
+// Whether a pose in this mode is published as certain (tracking, relocalized); lost and
+// ambiguous publish places the robot may be, never one pose.
+inline bool is_certain(LocalizerMode mode) {
+  return mode == LocalizerMode::tracking || mode == LocalizerMode::relocalized;
+}
 
 struct LocalizerOptions {
   EkfOptions ekf;                          // semi_axis is taken from robot.json
@@ -83,9 +88,7 @@ struct LocalizerEstimate {
   std::vector<WeightedPose> hypotheses;  // lost or ambiguous: every place it may be, best first
   bool undecidable = false;              // ambiguous between symmetry twins: no motion can decide
   std::string why;                       // lost or ambiguous: why, in words
-  bool known() const {
-    return mode == LocalizerMode::tracking || mode == LocalizerMode::relocalized;
-  }
+  bool known() const { return is_certain(mode); }
 };
 
 struct LocalizerEvent {
