@@ -36,6 +36,8 @@ Rgb place_colour(Place p) {
       return {0.93, 0.90, 0.78};
     case Place::room:
       return {0.92, 0.92, 0.92};
+    case Place::waypoint:
+      return {0.75, 0.75, 0.75};
   }
   return {1, 1, 1};
 }
@@ -157,8 +159,8 @@ void draw(cairo_t* cr, const graph::TopologicalMap& map, const View& v, const Dr
   cairo_set_font_size(cr, 12);
   cairo_set_source_rgb(cr, 0.05, 0.05, 0.2);
   for (const auto& n : map.nodes()) {
-    const Vector2d c = n.region.centroid();
-    text_centered(cr, n.name, v.px(c.x()), v.py(c.y()) + (n.axis ? 12 : 0));
+    const Vector2d c = n.region.size() >= 3 ? n.region.centroid() : n.point;
+    text_centered(cr, n.name, v.px(c.x()), v.py(c.y()) + (n.axis ? 12 : -8));
   }
   // Title, legend and a scale bar along the bottom.
   cairo_set_font_size(cr, 14);
@@ -211,10 +213,20 @@ void draw_map(const graph::TopologicalMap& map, const std::string& path,
   if (!png && !svg) throw InputError({path, "", ""}, "unknown picture format (use .png or .svg)");
   if (map.node_count() == 0) throw InputError({path, "", ""}, "the map has no nodes to draw");
 
-  graph::Box2 box{map.node_at_index(0).region.bounds()};
+  // Everything drawn: regions, node points (a Nav2 graph's waypoints have no region) and edges.
+  graph::Box2 box{map.node_at_index(0).point, map.node_at_index(0).point};
+  auto cover = [&box](const Vector2d& p) {
+    box.min = box.min.cwiseMin(p);
+    box.max = box.max.cwiseMax(p);
+  };
   for (const auto& n : map.nodes()) {
-    box.min = box.min.cwiseMin(n.region.bounds().min);
-    box.max = box.max.cwiseMax(n.region.bounds().max);
+    cover(n.point);
+    for (const auto& p : n.region.vertices()) cover(p);
+  }
+  for (const auto& e : map.edges()) {
+    for (const auto& line : e.geometry) {
+      for (const auto& p : line) cover(p);
+    }
   }
   const Vector2d size = (box.max - box.min).cwiseMax(Vector2d(1e-3, 1e-3));
   View v;

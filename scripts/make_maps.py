@@ -20,39 +20,60 @@ class MapBuilder:
         self.next_node = 1
         self.next_edge = 1000
         self.ids = {}
+        self.points = {}
 
-    def node(self, name, place, point, region, **metadata):
+    def node(self, name, place, point, region, axis=None, width=None, doors=None, lamps=None):
+        """A place. Format 2: what Nav2 can read in `metadata`, lamps and doors in `lampnav`."""
         fid = self.next_node
         self.next_node += 1
         self.ids[name] = fid
+        self.points[fid] = (float(point[0]), float(point[1]))
         xs = [float(p[0]) for p in region]
         ys = [float(p[1]) for p in region]
         md = {"name": name, "place": place}
-        md.update({k: v for k, v in metadata.items() if v is not None})
+        if axis is not None:
+            md["axis"] = {"x_values": [float(axis[0][0]), float(axis[1][0])],
+                          "y_values": [float(axis[0][1]), float(axis[1][1])]}
+        if width is not None:
+            md["width"] = width
         md["region"] = {"x_values": xs, "y_values": ys}
-        md.setdefault("lamps", [])
+        own = {}
+        if doors:
+            own["doors"] = doors
+        own["lamps"] = lamps or []
         self.features.append({
             "type": "Feature",
-            "geometry": {"type": "Point", "coordinates": [float(point[0]), float(point[1])]},
-            "properties": {"id": fid, "frame": "map", "metadata": md},
+            "geometry": {"type": "Point", "coordinates": list(self.points[fid])},
+            "properties": {"id": fid, "frame": "map", "metadata": md, "lampnav": own},
         })
-        return md
+        return own
 
     def edge(self, a, b, line):
-        """A two-way passage: two one-way edges, as Nav2 does."""
+        """A two-way passage: two one-way edges, as Nav2 does.
+
+        The cost is the polyline's length; it is written (with "overridable": false, or Nav2
+        ignores it) only where it is not the straight line between the node points, which is
+        what Nav2 scores an edge without a cost by.
+        """
         for s, e, pts in ((a, b, line), (b, a, list(reversed(line)))):
+            pts = [[round(p[0], 4), round(p[1], 4)] for p in pts]
+            props = {"id": self.next_edge, "startid": self.ids[s], "endid": self.ids[e]}
+            length = sum(math.dist(p, q) for p, q in zip(pts, pts[1:]))
+            straight = math.dist(self.points[self.ids[s]], self.points[self.ids[e]])
+            if abs(length - straight) > 1e-3:  # the points are rounded to 0.1 mm
+                props["cost"] = length
+                props["overridable"] = False
+            props["metadata"] = {}
             self.features.append({
                 "type": "Feature",
-                "geometry": {"type": "MultiLineString",
-                             "coordinates": [[[round(p[0], 4), round(p[1], 4)] for p in pts]]},
-                "properties": {"id": self.next_edge, "startid": self.ids[s], "endid": self.ids[e],
-                               "metadata": {}},
+                "geometry": {"type": "MultiLineString", "coordinates": [pts]},
+                "properties": props,
             })
             self.next_edge += 1
 
     def write(self, path):
         doc = {"type": "FeatureCollection", "name": self.name,
-               "lampnav": {"format": 1, "units": "m", "frame": "map"},
+               "lampnav": {"format": 2, "units": "m", "frame": "map"},
                "features": self.features}
         with open(path, "w") as f:
             json.dump(doc, f, indent=1)
@@ -100,7 +121,7 @@ def office_floor():
         mid = ((ax + bx) / 2, (ay + by) / 2)
         node_points[name] = mid
         corridor_axes[name] = (a, b, (dx, dy))
-        m.node(name, "corridor", mid, region, axis=[list(a), list(b)], width=2.0,
+        m.node(name, "corridor", mid, region, axis=[a, b], width=2.0,
                doors=[{"name": d[0], "side": d[1], "at": d[2]} for d in doors], lamps=lamps)
 
     place("E1", "end", 1, 10)
@@ -141,8 +162,8 @@ def office_floor():
     for door, corr, room in doors:
         (ax, ay), _, (dx, dy) = corridor_axes[corr]
         spec = next(d for d in m.features if d["properties"].get("metadata", {}).get("name") == corr)
-        at = next(d["at"] for d in spec["properties"]["metadata"]["doors"] if d["name"] == door)
-        side = next(d["side"] for d in spec["properties"]["metadata"]["doors"] if d["name"] == door)
+        at = next(d["at"] for d in spec["properties"]["lampnav"]["doors"] if d["name"] == door)
+        side = next(d["side"] for d in spec["properties"]["lampnav"]["doors"] if d["name"] == door)
         lx, ly = (-dy, dx) if side == "left" else (dy, -dx)
         px, py = ax + dx * at, ay + dy * at          # on the axis
         wx, wy = px + lx * 1.0, py + ly * 1.0          # on the wall

@@ -22,6 +22,8 @@ const char* to_string(Place p) {
       return "hall";
     case Place::room:
       return "room";
+    case Place::waypoint:
+      return "waypoint";
   }
   return "?";
 }
@@ -92,6 +94,12 @@ TopologicalMap::~TopologicalMap() = default;
 
 const std::string& TopologicalMap::name() const { return impl_->name; }
 void TopologicalMap::set_name(std::string name) { impl_->name = std::move(name); }
+bool TopologicalMap::plain_nav2() const { return impl_->plain_nav2; }
+void TopologicalMap::set_plain_nav2(bool plain) { impl_->plain_nav2 = plain; }
+const std::string& TopologicalMap::nav2_keys() const { return impl_->nav2_keys; }
+void TopologicalMap::set_nav2_keys(std::string json_object) {
+  impl_->nav2_keys = std::move(json_object);
+}
 
 void TopologicalMap::add_node(Node node) {
   Impl& m = *impl_;
@@ -111,7 +119,7 @@ void TopologicalMap::add_node(Node node) {
   const Node& n = m.g[v];
   m.vertex_by_id.emplace(n.id.value, v);
   m.vertex_by_name.emplace(n.name, v);
-  m.region_index.insert(n.region.bounds(), v);
+  if (n.region.size() >= 3) m.region_index.insert(n.region.bounds(), v);
   for (std::size_t i = 0; i < n.lamps.size(); ++i) {
     m.lamp_by_id.emplace(n.lamps[i].id.value, LampRef{v, i});
     const Eigen::Vector2d p = n.lamps[i].xyz.head<2>();
@@ -122,7 +130,7 @@ void TopologicalMap::add_node(Node node) {
 
 void TopologicalMap::add_edge(Edge edge) {
   Impl& m = *impl_;
-  if (m.vertex_by_id.count(edge.id.value) || m.edge_by_id.count(edge.id.value)) {
+  if (m.vertex_by_id.count(edge.id.value) || (m.edge_by_id.count(edge.id.value) && !m.plain_nav2)) {
     throw Error("duplicate feature id " + std::to_string(edge.id.value));
   }
   const Vertex a = m.vertex(edge.start);
@@ -130,7 +138,7 @@ void TopologicalMap::add_edge(Edge edge) {
   const std::int64_t id = edge.id.value;
   const auto [e, added] = boost::add_edge(a, b, std::move(edge), m.g);
   (void)added;  // parallel edges are allowed (vecS out-edge lists)
-  m.edge_by_id.emplace(id, m.edge_order.size());
+  m.edge_by_id.emplace(id, m.edge_order.size());  // a repeated id keeps the first
   m.edge_order.push_back(e);
 }
 

@@ -52,7 +52,7 @@ std::vector<MapWarning> check_camera_coverage(const TopologicalMap& map, const C
     }
     if (worst < cov.speed) {
       out.push_back(
-          {{file, node_place(node), "properties.metadata.lamps[" + std::to_string(worst_i) + "]"},
+          {{file, node_place(node), "properties.lampnav.lamps[" + std::to_string(worst_i) + "]"},
            "at " + fmt(cov.speed) + " m/s and " + fmt(cov.frame_rate) +
                " frames/s the ceiling camera could miss or confuse lamp '" +
                node.lamps[worst_i].id.value + "'; the highest safe speed here is " + fmt(worst) +
@@ -94,7 +94,7 @@ std::vector<MapWarning> check_map(const TopologicalMap& map, const MapCheckOptio
   }
   for (std::size_t v = 0; v < n; ++v) {
     if (g[v].place == Place::corridor && g[v].lamps.empty()) {
-      out.push_back({{file, node_place(g[v]), "properties.metadata.lamps"},
+      out.push_back({{file, node_place(g[v]), "properties.lampnav.lamps"},
                      "corridor without lamps: the ceiling camera cannot localize here"});
     }
   }

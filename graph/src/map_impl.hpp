@@ -53,6 +53,8 @@ struct LampRef {
 
 struct TopologicalMap::Impl {
   std::string name;
+  bool plain_nav2 = false;
+  std::string nav2_keys;
   Graph g;
   std::vector<EdgeDesc> edge_order;  // insertion order
   std::unordered_map<std::int64_t, Vertex> vertex_by_id;

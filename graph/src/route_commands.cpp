@@ -200,6 +200,13 @@ std::vector<RouteCommand> route_to_commands(const TopologicalMap& map, const Rou
         }
         continuing = false;
         break;
+      case Place::waypoint:  // a Nav2 graph: no places to speak of, each waypoint by name
+        if (prev) {
+          c.kind = CommandKind::go_to;
+          emit(c);
+        }
+        continuing = false;
+        break;
     }
   }
   return cmds;

@@ -40,18 +40,24 @@ struct Writer {
   static Json region(double x0, double y0, double x1, double y1) {
     return {{"x_values", {x0, x1, x1, x0}}, {"y_values", {y0, y0, y1, y1}}};
   }
+  // A place in map format 2: what Nav2 reads in `metadata`, lamps and doors in `lampnav`. Returns
+  // the feature's properties.
   Json& node(const std::string& name, const char* place, double x, double y, Json region_json) {
     ids[name] = next_id;
     points[name] = {x, y};
     Json md = {{"name", name}, {"place", place}};
     md["region"] = std::move(region_json);
-    md["lamps"] = Json::array();
     features.push_back({{"type", "Feature"},
                         {"geometry", {{"type", "Point"}, {"coordinates", {x, y}}}},
-                        {"properties", {{"id", next_id++}, {"frame", "map"}, {"metadata", md}}}});
-    return features.back()["properties"]["metadata"];
+                        {"properties",
+                         {{"id", next_id++},
+                          {"frame", "map"},
+                          {"metadata", md},
+                          {"lampnav", {{"lamps", Json::array()}}}}}});
+    return features.back()["properties"];
   }
-  void lamp(Json& md, const std::string& id, double x, double y, double z, double yaw, bool disc) {
+  void lamp(Json& props, const std::string& id, double x, double y, double z, double yaw,
+            bool disc) {
     Json l = {{"id", id}, {"xyz", {x, y, z}}};
     if (disc) {
       l["shape"] = "disc";
@@ -61,7 +67,7 @@ struct Writer {
       l["shape"] = "rectangle";
       l["size"] = {1.2, 0.3};
     }
-    md["lamps"].push_back(std::move(l));
+    props["lampnav"]["lamps"].push_back(std::move(l));
     ++lamps;
   }
   void link(const std::string& a, const std::string& b) {
@@ -164,18 +170,18 @@ Building generate_building(const BuildingOptions& o) {
            (j > 0 && j + 1 < k && !missing.count(V(i, j - 1)) && !missing.count(V(i, j))));
       const char* place = n <= 1 ? "end" : n == 2 && !straight ? "corner" : "junction";
       const double x = i * S, y = j * S;
-      Json& md = w.node(J(i, j), place, x, y, Writer::region(x - 1, y - 1, x + 1, y + 1));
-      w.lamp(md, J(i, j) + "-L1", x, y, z, 0.0, false);
+      Json& props = w.node(J(i, j), place, x, y, Writer::region(x - 1, y - 1, x + 1, y + 1));
+      w.lamp(props, J(i, j) + "-L1", x, y, z, 0.0, false);
     }
   auto corridor = [&](const std::string& name, double x0, double y0, double x1, double y1,
                       bool room_door) {
     const bool horizontal = y0 == y1;
     const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
-    Json& md = w.node(name, "corridor", cx, cy,
-                      horizontal ? Writer::region(x0, y0 - 1, x1, y0 + 1)
-                                 : Writer::region(x0 - 1, y0, x0 + 1, y1));
-    md["axis"] = {{x0, y0}, {x1, y1}};
-    md["width"] = 2.0;
+    Json& props = w.node(name, "corridor", cx, cy,
+                         horizontal ? Writer::region(x0, y0 - 1, x1, y0 + 1)
+                                    : Writer::region(x0 - 1, y0, x0 + 1, y1));
+    props["metadata"]["axis"] = {{"x_values", {x0, x1}}, {"y_values", {y0, y1}}};
+    props["metadata"]["width"] = 2.0;
     const double len = std::hypot(x1 - x0, y1 - y0);
     const bool wing = o.wing_lamp_spacing_m > 0 && std::min(x0, x1) >= 0.5 * (k - 1) * S;
     const double spacing = wing ? o.wing_lamp_spacing_m : o.lamp_spacing_m;
@@ -183,11 +189,12 @@ Building generate_building(const BuildingOptions& o) {
     const double first = 0.5 * (len - (n - 1) * spacing);
     for (int q = 0; q < n; ++q) {
       const double s = first + q * spacing;
-      w.lamp(md, name + "-L" + std::to_string(q + 1), horizontal ? x0 + s : x0,
+      w.lamp(props, name + "-L" + std::to_string(q + 1), horizontal ? x0 + s : x0,
              horizontal ? y0 : y0 + s, z, horizontal ? 0.0 : M_PI / 2, false);
     }
     if (room_door)
-      md["doors"] = Json::array({{{"name", "D" + name}, {"side", "left"}, {"at", 0.5 * len}}});
+      props["lampnav"]["doors"] =
+          Json::array({{{"name", "D" + name}, {"side", "left"}, {"at", 0.5 * len}}});
   };
   for (int i = 0; i + 1 < k; ++i)
     for (int j = 0; j < k; ++j) {
@@ -202,11 +209,11 @@ Building generate_building(const BuildingOptions& o) {
       w.node("D" + H(i, j), "door", x, y + 1.15, Writer::region(x - 0.5, y + 1, x + 0.5, y + 1.3));
       const std::string room_name = "R" + std::to_string(i) + "_" + std::to_string(j);
       const double rx0 = i * S + 2, rx1 = (i + 1) * S - 2, ry0 = y + 1.3, ry1 = y + 0.5 * S;
-      Json& md = w.node(room_name, "room", 0.5 * (rx0 + rx1), 0.5 * (ry0 + ry1),
-                        Writer::region(rx0, ry0, rx1, ry1));
+      Json& props = w.node(room_name, "room", 0.5 * (rx0 + rx1), 0.5 * (ry0 + ry1),
+                           Writer::region(rx0, ry0, rx1, ry1));
       for (int a = 0; a < 4; ++a)
         for (int c = 0; c < 4; ++c)
-          w.lamp(md, room_name + "-L" + std::to_string(4 * a + c + 1),
+          w.lamp(props, room_name + "-L" + std::to_string(4 * a + c + 1),
                  rx0 + (a + 0.5) * (rx1 - rx0) / 4, ry0 + (c + 0.5) * (ry1 - ry0) / 4, z, 0.0,
                  true);
       w.link(H(i, j), "D" + H(i, j));
@@ -222,12 +229,12 @@ Building generate_building(const BuildingOptions& o) {
   if (o.lobby) {
     // A 10 x 8 m hall west of the origin's corner, entered from it, with round lamps in a grid.
     const double x0 = -11, x1 = -1, y0 = -4, y1 = 4;
-    Json& md =
+    Json& props =
         w.node("Lobby", "hall", 0.5 * (x0 + x1), 0.5 * (y0 + y1), Writer::region(x0, y0, x1, y1));
     int q = 0;
     for (double x = x0 + 1.25; x < x1; x += 2.5)
       for (double y = y0 + 2; y < y1; y += 2.0)
-        w.lamp(md, "Lobby-L" + std::to_string(++q), x, y, z, 0.0, true);
+        w.lamp(props, "Lobby-L" + std::to_string(++q), x, y, z, 0.0, true);
     w.link("Lobby", J(0, 0));
   }
   b.grid = k;
@@ -236,7 +243,7 @@ Building generate_building(const BuildingOptions& o) {
   b.lamps = w.lamps;
   Json doc = {{"type", "FeatureCollection"},
               {"name", "generated-" + std::to_string(b.nodes)},
-              {"lampnav", {{"format", 1}, {"units", "m"}, {"frame", "map"}}},
+              {"lampnav", {{"format", 2}, {"units", "m"}, {"frame", "map"}}},
               {"features", std::move(w.features)}};
   b.geojson = doc.dump();
   return b;

@@ -167,10 +167,18 @@ graph::TopologicalMap symmetric_hall() {
       ++k;
     }
   const std::string text =
-      R"({"type": "FeatureCollection", "name": "symmetric", "lampnav": {"format": 1, "units": "m", "frame": "map"},
+      R"({"type": "FeatureCollection", "name": "symmetric", "lampnav": {"format": 2, "units": "m", "frame": "map"},
       "features": [{"type": "Feature", "geometry": {"type": "Point", "coordinates": [0.0, 0.0]},
-      "properties": {"id": 1, "frame": "map", "metadata": {"name": "H", "place": "hall", "lamps": [)" +
-      lamps + R"(], "region": {"x_values": [-7, 7, 7, -7], "y_values": [-4, -4, 4, 4]}}}}]})";
+      "properties": {"id": 1, "frame": "map", "metadata": {"name": "H", "place": "hall",
+      "region": {"x_values": [-7, 7, 7, -7], "y_values": [-4, -4, 4, 4]}}, "lampnav": {"lamps": [)" +
+      lamps + R"(]}}},
+      {"type": "Feature", "geometry": {"type": "Point", "coordinates": [7.15, 0.0]},
+      "properties": {"id": 2, "frame": "map", "metadata": {"name": "Door", "place": "door",
+      "region": {"x_values": [7, 7.3, 7.3, 7], "y_values": [-0.5, -0.5, 0.5, 0.5]}}}},
+      {"type": "Feature", "geometry": {"type": "MultiLineString", "coordinates": [[[0, 0], [7.15, 0]]]},
+      "properties": {"id": 3, "startid": 1, "endid": 2}},
+      {"type": "Feature", "geometry": {"type": "MultiLineString", "coordinates": [[[7.15, 0], [0, 0]]]},
+      "properties": {"id": 4, "startid": 2, "endid": 1}}]})";
   return graph::parse_map(text, "symmetric.geojson").map;
 }
 

@@ -1,4 +1,5 @@
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
 
 #include "lampnav/core/error.hpp"
@@ -53,7 +54,7 @@ INSTANTIATE_TEST_SUITE_P(
         Refusal{"duplicate_id", "features[3] (id 1)", "properties.id", "duplicate id 1"},
         Refusal{"duplicate_name", "features[1] (id 2)", "properties.metadata.name",
                 "duplicate name 'C1'"},
-        Refusal{"duplicate_lamp_id", "features[0] (id 1)", "properties.metadata.lamps[1].id",
+        Refusal{"duplicate_lamp_id", "features[0] (id 1)", "properties.lampnav.lamps[1].id",
                 "duplicate lamp id"},
         Refusal{"dangling_edge", "features[3] (id 11)", "properties.endid", "names no node (99)"},
         Refusal{"unknown_place", "features[1] (id 2)", "properties.metadata.place",
@@ -62,10 +63,10 @@ INSTANTIATE_TEST_SUITE_P(
                 "expected 2 elements"},
         Refusal{"null_coordinate", "features[1] (id 2)", "geometry.coordinates[1]",
                 "expected a number"},
-        Refusal{"nonfinite_coordinate", "line 95, column 6", "", "not a finite number"},
-        Refusal{"lamp_outside_region", "features[0] (id 1)", "properties.metadata.lamps[1].xyz",
+        Refusal{"nonfinite_coordinate", "line 97, column 6", "", "not a finite number"},
+        Refusal{"lamp_outside_region", "features[0] (id 1)", "properties.lampnav.lamps[1].xyz",
                 "outside its node's region"},
-        Refusal{"lamp_below_floor", "features[0] (id 1)", "properties.metadata.lamps[0].xyz",
+        Refusal{"lamp_below_floor", "features[0] (id 1)", "properties.lampnav.lamps[0].xyz",
                 "above the floor"},
         Refusal{"region_too_few_vertices", "features[1] (id 2)", "properties.metadata.region",
                 "fewer than 3 vertices"},
@@ -77,16 +78,17 @@ INSTANTIATE_TEST_SUITE_P(
                 "overlaps the region of 'C1'"},
         Refusal{"unknown_key_metadata", "features[0] (id 1)", "properties.metadata.lamsp",
                 "unknown key"},
-        Refusal{"unknown_key_lamp", "features[0] (id 1)", "properties.metadata.lamps[0].colour",
+        Refusal{"unknown_key_lamp", "features[0] (id 1)", "properties.lampnav.lamps[0].colour",
                 "unknown key"},
-        Refusal{"unknown_key_door", "features[0] (id 1)", "properties.metadata.doors[0].sdie",
+        Refusal{"unknown_key_door", "features[0] (id 1)", "properties.lampnav.doors[0].sdie",
                 "unknown key"},
         Refusal{"unknown_key_lampnav", "", "lampnav.unit", "unknown key"},
-        Refusal{"unknown_key_edge_metadata", "features[2] (id 10)", "properties.metadata.speed",
-                "unknown key"},
+        Refusal{"nav2_unconvertible_metadata", "features[2] (id 10)",
+                "properties.metadata.speed[0]",
+                "Nav2's route graph loader cannot convert an array of objects"},
         Refusal{"corridor_without_axis", "features[0] (id 1)", "properties.metadata.axis",
                 "missing"},
-        Refusal{"bad_lamp_size", "features[0] (id 1)", "properties.metadata.lamps[0].size",
+        Refusal{"bad_lamp_size", "features[0] (id 1)", "properties.lampnav.lamps[0].size",
                 "length >= width"}),
     [](const auto& p) { return std::string(p.param.file); });
 
@@ -125,8 +127,7 @@ TEST(MapReader, WarnsButAccepts) {
   std::string all;
   for (const auto& w : lm.warnings) all += w.text() + "\n";
   EXPECT_THAT(all, HasSubstr("node 'Lonely' (id 3): no edge reaches this node"));
-  EXPECT_THAT(all,
-              HasSubstr("node 'C1' (id 1): properties.metadata.lamps: corridor without lamps"));
+  EXPECT_THAT(all, HasSubstr("node 'C1' (id 1): properties.lampnav.lamps: corridor without lamps"));
 }
 
 TEST(MapReader, EdgeCostDefaultsToGeometricLength) {
@@ -174,7 +175,8 @@ TEST_P(RoundTrip, WriteReadIsIdentity) {
 
 INSTANTIATE_TEST_SUITE_P(BundledMaps, RoundTrip,
                          ::testing::Values("maps/office_floor.geojson", "maps/domus_museum.geojson",
-                                           "tests/fixtures/maps/valid_tiny.geojson"));
+                                           "tests/fixtures/maps/valid_tiny.geojson",
+                                           "tests/fixtures/maps/format1_tiny.geojson"));
 
 }  // namespace
 }  // namespace lampnav::graph
@@ -182,35 +184,31 @@ INSTANTIATE_TEST_SUITE_P(BundledMaps, RoundTrip,
 namespace lampnav::graph {
 namespace {
 
-// Format 2 (map-format.md): lamps and doors under properties.lampnav, the axis as x_values and
-// y_values. The same map in either format reads the same.
-nlohmann::json to_format_2(nlohmann::json doc) {
-  doc["lampnav"]["format"] = 2;
+// Format 1 (map-format.md, replaced by format 2): lamps and doors in metadata, the axis as two
+// [x, y] points, a written cost taken as it is. The same map in either format reads the same.
+nlohmann::json to_format_1(nlohmann::json doc) {
+  doc["lampnav"]["format"] = 1;
   for (auto& f : doc["features"]) {
     auto& props = f["properties"];
-    if (!props.contains("metadata")) continue;
+    props.erase("overridable");
+    if (!props.contains("lampnav")) continue;
     auto& md = props["metadata"];
-    nlohmann::json ln = nlohmann::json::object();
-    for (const char* k : {"lamps", "doors"})
-      if (md.contains(k)) {
-        ln[k] = md[k];
-        md.erase(k);
-      }
-    if (!ln.empty()) props["lampnav"] = ln;
+    for (auto& [k, v] : props["lampnav"].items()) md[k] = v;
+    props.erase("lampnav");
     if (md.contains("axis")) {
       const auto a = md["axis"];
-      md["axis"] = {{"x_values", {a[0][0], a[1][0]}}, {"y_values", {a[0][1], a[1][1]}}};
+      md["axis"] = {{a["x_values"][0], a["y_values"][0]}, {a["x_values"][1], a["y_values"][1]}};
     }
   }
   return doc;
 }
 
-TEST(MapReader, ReadsFormat2AsFormat1) {
+TEST(MapReader, ReadsFormat1AsFormat2) {
   for (const char* file : {"maps/office_floor.geojson", "maps/domus_museum.geojson"}) {
     const std::string text = test::slurp(test::source_path(file));
-    const TopologicalMap one = parse_map(text, file).map;
-    const std::string two_text = to_format_2(nlohmann::json::parse(text)).dump();
-    const TopologicalMap two = parse_map(two_text, "format 2").map;
+    const TopologicalMap two = parse_map(text, file).map;
+    const std::string one_text = to_format_1(nlohmann::json::parse(text)).dump();
+    const TopologicalMap one = parse_map(one_text, "format 1").map;
     ASSERT_EQ(one.node_count(), two.node_count()) << file;
     ASSERT_EQ(one.edge_count(), two.edge_count());
     ASSERT_EQ(one.lamp_count(), two.lamp_count());
@@ -230,13 +228,17 @@ TEST(MapReader, ReadsFormat2AsFormat1) {
       }
       EXPECT_EQ(a.doors.size(), b.doors.size()) << a.name;
     }
+    // Format 1 costs an edge without a cost by its polyline; format 2 by the straight line, so
+    // the bundled maps write the polyline's length where it differs. Planning is the same.
+    for (std::size_t i = 0; i < one.edge_count(); ++i)
+      EXPECT_NEAR(one.edge_at_index(i).cost, two.edge_at_index(i).cost, 2e-4) << i;
   }
 }
 
 TEST(MapReader, Format2RefusesLampsInMetadata) {
   const std::string text = test::slurp(test::source_path("maps/office_floor.geojson"));
-  nlohmann::json doc = nlohmann::json::parse(text);
-  doc["lampnav"]["format"] = 2;  // lamps still in metadata, where Nav2's loader throws
+  nlohmann::json doc = to_format_1(nlohmann::json::parse(text));
+  doc["lampnav"]["format"] = 2;  // lamps in metadata, where Nav2's loader throws
   try {
     parse_map(doc.dump(), "m.geojson");
     FAIL() << "accepted";
@@ -244,6 +246,73 @@ TEST(MapReader, Format2RefusesLampsInMetadata) {
     EXPECT_THAT(std::string(e.what()), HasSubstr("lamps"));
   } catch (const InputError& e) {
     EXPECT_THAT(std::string(e.what()), HasSubstr("lamps"));
+  }
+}
+
+// A format-1 map is written back in format 2 with its edge costs kept for Nav2: a polyline's
+// length where it is not the straight line, with "overridable": false.
+TEST(MapWriter, WritesFormat2FromFormat1) {
+  const LoadedMap one = read_map(test::fixture("maps/format1_tiny.geojson"));
+  const nlohmann::json doc = nlohmann::json::parse(write_map(one.map));
+  EXPECT_EQ(doc["lampnav"]["format"], 2);
+  for (const auto& f : doc["features"]) {
+    const auto& props = f["properties"];
+    if (f["geometry"]["type"] == "Point") {
+      EXPECT_FALSE(props["metadata"].contains("lamps"));
+      EXPECT_TRUE(props.contains("lampnav"));
+      if (props["metadata"].contains("axis")) {
+        EXPECT_TRUE(props["metadata"]["axis"].is_object());
+      }
+    } else if (props.contains("cost")) {
+      EXPECT_EQ(props["overridable"], false);
+    }
+  }
+  const LoadedMap two = parse_map(doc.dump(), "written");
+  for (std::size_t i = 0; i < one.map.edge_count(); ++i)
+    EXPECT_DOUBLE_EQ(one.map.edge_at_index(i).cost, two.map.edge_at_index(i).cost);
+}
+
+TEST(MapReader, RefusesWhatNav2CannotLoad) {
+  const std::string text = test::slurp(test::fixture("maps/valid_tiny.geojson"));
+  struct Case {
+    const char* what;
+    std::function<void(nlohmann::json&)> change;
+    const char* field;
+    const char* message;
+  };
+  const std::vector<Case> cases = {
+      {"negative id", [](auto& d) { d["features"].back()["properties"]["id"] = -1; },
+       "properties.id", "unsigned 32-bit"},
+      {"id past 32 bits", [](auto& d) { d["features"].back()["properties"]["id"] = 5000000000LL; },
+       "properties.id", "unsigned 32-bit"},
+      {"no edges",
+       [](auto& d) {
+         auto& fs = d["features"];
+         for (std::size_t i = fs.size(); i-- > 0;)
+           if (fs[i]["geometry"]["type"] != "Point") fs.erase(i);
+       },
+       "features", "at least one node and one edge"},
+      {"not overridable, no cost",
+       [](auto& d) { d["features"].back()["properties"]["overridable"] = false; }, "properties",
+       "needs a positive cost"},
+      {"unknown trigger",
+       [](auto& d) {
+         d["features"][0]["properties"]["operations"] = {
+             {"stop", {{"type", "stop"}, {"trigger", "ON_ARRIVAL"}}}};
+       },
+       "properties.operations.stop.trigger", "unknown trigger"},
+  };
+  for (const auto& c : cases) {
+    nlohmann::json doc = nlohmann::json::parse(text);
+    c.change(doc);
+    try {
+      parse_map(doc.dump(), "m.geojson");
+      ADD_FAILURE() << c.what << ": accepted";
+    } catch (const InputErrors& e) {
+      ASSERT_EQ(e.problems().size(), 1u) << c.what << ": " << e.what();
+      EXPECT_THAT(e.problems()[0].where().field, HasSubstr(c.field)) << c.what;
+      EXPECT_THAT(e.problems()[0].message(), HasSubstr(c.message)) << c.what;
+    }
   }
 }
 

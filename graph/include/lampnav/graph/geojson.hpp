@@ -1,6 +1,7 @@
 #pragma once
 // The map file format (map-format.md): one GeoJSON FeatureCollection following the Nav2 Route
-// Server's graph-file conventions, with lampnav's facts under `metadata`.
+// Server's graph-file conventions that nav2_route loads as it is, lampnav's own data under
+// `properties.lampnav`.
 
 #include <string>
 #include <vector>
@@ -23,7 +24,7 @@ struct LoadedMap {
 };
 
 // The map format the writer writes (the reader reads formats 1 and 2: map-format.md).
-constexpr int kMapFormat = 1;
+constexpr int kMapFormat = 2;
 // Regions may touch; they may overlap by at most this area before the map is refused (m^2).
 constexpr double kRegionOverlapTolerance = 0.01;
 

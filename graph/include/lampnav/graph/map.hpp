@@ -17,8 +17,11 @@
 
 namespace lampnav::graph {
 
-enum class Place { corridor, junction, corner, end, door, hall, room };
+// `waypoint` is a node of a plain Nav2 route graph (map-format.md, last section): a point of the
+// graph with no place, region or lamps; it is never written as a lampnav place.
+enum class Place { corridor, junction, corner, end, door, hall, room, waypoint };
 const char* to_string(Place p);
+// The places a lampnav map may name (all but `waypoint`).
 std::optional<Place> place_from_string(const std::string& s);
 
 enum class LampShape { rectangle, disc };
@@ -74,6 +77,9 @@ struct Node {
   std::optional<double> length_override;  // m, metadata.length
   std::vector<Door> doors;
   std::vector<Lamp> lamps;  // in walking order from the axis' first end (halls: stable order)
+  // Nav2's keys that lampnav keeps but does not read (`operations`; for a plain Nav2 graph also
+  // `frame` and the whole `metadata`), as the text of a JSON object written back unchanged.
+  std::string nav2_keys;
 
   // metadata.length if given, else the axis length, else 0.
   double length() const;
@@ -83,9 +89,19 @@ struct Node {
 struct Edge {
   EdgeId id;
   NodeId start, end;
-  double cost = 0.0;                                   // the effective cost used by planning
+  // The cost planning uses, as Nav2's route server scores it: `cost_given` when `overridable` is
+  // false, else the straight line between the two node points (map-format.md). A map made in
+  // code sets it; the writer writes it (with "overridable": false) where it is not the line.
+  double cost = 0.0;
   std::optional<double> cost_given;                    // `cost` as written in the file
-  std::vector<std::vector<Eigen::Vector2d>> geometry;  // MultiLineString
+  std::optional<bool> overridable;                     // Nav2's flag as written in the file
+  std::vector<std::vector<Eigen::Vector2d>> geometry;  // MultiLineString (or one LineString)
+  bool line_string = false;                            // written as a LineString
+  // A plain Nav2 graph's edge geometry that is no valid line (Nav2 ignores edge geometry), as
+  // JSON text written back as it came; `geometry` is then the straight line between the nodes.
+  std::string nav2_geometry;
+  // Nav2's keys kept but not read (`metadata`, `operations`, ...), as JSON object text.
+  std::string nav2_keys;
   double geometric_length() const;
 };
 
@@ -100,11 +116,20 @@ class TopologicalMap {
 
   const std::string& name() const;
   void set_name(std::string name);
+  // A plain Nav2 route graph (a file with no `lampnav` block) is written back as one: its nodes
+  // are waypoints, and edge ids may repeat, as Nav2 allows.
+  bool plain_nav2() const;
+  void set_plain_nav2(bool plain);
+  // The file's top-level keys lampnav keeps but does not read (`crs`, `date_generated`, ...), as
+  // JSON object text written back unchanged.
+  const std::string& nav2_keys() const;
+  void set_nav2_keys(std::string json_object);
 
   // Adds a node; throws lampnav::Error on a duplicate id, name or lamp id. Each lamp's `node` is
   // set to this node.
   void add_node(Node node);
-  // Adds a one-way edge; throws lampnav::Error when an end names no node or the id is taken.
+  // Adds a one-way edge; throws lampnav::Error when an end names no node or the id is taken (in
+  // a plain Nav2 graph, by a node: edges may share ids there; find_edge gives the first).
   void add_edge(Edge edge);
 
   std::size_t node_count() const;
