@@ -58,6 +58,7 @@ struct LampSensors::Impl {
   Matrix3d ceiling_R;
   Vector3d ceiling_t;
   double omni_reach = 0;  // m, lamps further away are below the omni's horizon limit
+  double omni_top = 0;    // m, the highest lamp above the omni camera
 
   bool works(const graph::Lamp& l) const { return !o.failed_lamps.count(l.id.value); }
 
@@ -85,6 +86,7 @@ LampSensors::LampSensors(const graph::TopologicalMap& map, const RobotDescriptio
     double top = 0;
     for (const auto& n : map.nodes())
       for (const auto& l : n.lamps) top = std::max(top, l.xyz.z() - m.omni_t.z());
+    m.omni_top = top;
     m.omni_reach = top * std::tan(std::min(89.0, m.o.omni_max_theta_deg) * kDeg) + 2.0;
   }
   if (const CameraDescription* c = robot.find_camera("ceiling_camera")) {
@@ -94,6 +96,14 @@ LampSensors::LampSensors(const graph::TopologicalMap& map, const RobotDescriptio
   }
 }
 LampSensors::~LampSensors() = default;
+double LampSensors::omni_resolving_radius_m(double tolerance_m) const {
+  const Impl& m = *impl_;
+  if (!m.omni || !(m.omni_top > 0) || !(tolerance_m > 0)) return 0.0;
+  const double cos2 = 3 * m.o.omni_sigma_deg * kDeg * m.omni_top / tolerance_m;
+  if (cos2 >= 1) return 0.0;
+  const double theta = std::min(std::acos(std::sqrt(cos2)), m.o.omni_max_theta_deg * kDeg);
+  return m.omni_top * std::tan(theta);
+}
 LampSensors::LampSensors(LampSensors&&) noexcept = default;
 
 vision::OmniDetection LampSensors::omni(const Pose2& pose, std::mt19937_64& rng) const {

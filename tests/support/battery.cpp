@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "lampnav/graph/planner.hpp"
+#include "lampnav/sim/map_oracle.hpp"
 
 namespace lampnav::test {
 
@@ -98,6 +99,7 @@ struct Battery::Impl {
   BatteryOptions o;
   fusion::LocalizerOptions lo;
   sim::LampSensors sensors;
+  std::optional<sim::MapOracle> oracle;
   std::vector<const graph::Node*> corridors;
 
   Impl(const graph::TopologicalMap& m, const RobotDescription& r, const BatteryOptions& opt,
@@ -105,6 +107,12 @@ struct Battery::Impl {
       : map(&m), robot(r), o(opt), lo(l), sensors(m, r, opt.sensors) {
     for (const auto& n : m.nodes())
       if (n.place == graph::Place::corridor && n.axis) corridors.push_back(&n);
+    sim::MapOracleOptions oo;
+    if (o.oracle && sensors.omni_resolving_radius_m(oo.tolerance_m) > oo.border_m) {
+      oo.view_radius_m = sensors.omni_resolving_radius_m(oo.tolerance_m);
+      oo.failed_lamps = o.sensors.failed_lamps;
+      oracle.emplace(m, oo);
+    }
   }
 
   // Anywhere along a corridor (not within 0.5 m of its ends), at any heading.
@@ -143,6 +151,7 @@ struct Battery::Impl {
       loc.initialize(stamp(0), truth, Eigen::Vector3d(1e-4, 1e-4, 3e-4).asDiagonal());
     std::optional<double> kidnapped_at, kidnap_travel, detected_at, fixed_at;
     bool wrong = false;
+    std::vector<sim::DriveSample> drive;  // from the kidnap (or start) on, every 0.25 m
     while (true) {
       // Truth and wheels.
       const auto [v, w] = driver.command(truth, o.speed);
@@ -193,6 +202,11 @@ struct Battery::Impl {
         ++r.frames;
         pending.pop_front();
       }
+      if ((!kidnap_at_m || kidnapped_at) && o.oracle) {
+        const double since_m = travel - kidnap_travel.value_or(0.0);
+        if (drive.empty() || since_m - drive.back().travel_m >= 0.25)
+          drive.push_back({since_m, truth});
+      }
       // Score what it publishes now.
       const fusion::LocalizerEstimate e = loc.estimate();
       const bool after = !kidnap_at_m || kidnapped_at;
@@ -231,6 +245,11 @@ struct Battery::Impl {
     r.detected = kidnap_at_m && detected_at;
     if (detected_at) r.detection_s = *detected_at - *kidnapped_at;
     if (!r.fixed) r.last_why = loc.relocalization().why;
+    if (oracle) {
+      const sim::OracleVerdict v = oracle->judge(drive);
+      r.oracle_m = v.distinguishing_m;
+      r.oracle_twins = v.twins;
+    }
     return r;
   }
 };
@@ -263,7 +282,7 @@ EpisodeResult Battery::unknown_start_at(const Pose2& start, std::uint64_t seed) 
 
 BatteryFigures figures(const std::vector<EpisodeResult>& rs) {
   BatteryFigures f;
-  std::vector<double> lat_s, lat_m;
+  std::vector<double> lat_s, lat_m, past;
   double unsure_s = 0;
   std::size_t unsure_frames = 0, unsure_hyp = 0;
   for (const auto& r : rs) {
@@ -280,6 +299,12 @@ BatteryFigures figures(const std::vector<EpisodeResult>& rs) {
       lat_s.push_back(r.latency_s);
       lat_m.push_back(r.latency_m);
     }
+    if (r.oracle_m) {
+      ++f.oracle_decided;
+      if (r.fixed) past.push_back(r.latency_m - *r.oracle_m);
+    }
+    // An oracle still undecided at the end of the drive decides later than the fix, if any.
+    if (r.fix_correct && (!r.oracle_m || r.latency_m <= *r.oracle_m + 10)) ++f.within_oracle_10m;
   }
   auto pct = [](std::vector<double> v, double q) {
     if (v.empty()) return 0.0;
@@ -290,6 +315,8 @@ BatteryFigures figures(const std::vector<EpisodeResult>& rs) {
   f.latency_s_p95 = pct(lat_s, 0.95);
   f.latency_m_median = pct(lat_m, 0.5);
   f.latency_m_p95 = pct(lat_m, 0.95);
+  f.past_oracle_m_median = pct(past, 0.5);
+  f.past_oracle_m_p95 = pct(past, 0.95);
   if (unsure_frames) {
     f.unsure_us_per_frame = 1e6 * unsure_s / unsure_frames;
     f.unsure_mean_hypotheses = double(unsure_hyp) / unsure_frames;
@@ -303,7 +330,10 @@ std::string summarize(const std::vector<EpisodeResult>& rs) {
   s << f.episodes << " episodes: " << f.detected << " detected, " << f.fixed << " fixed, "
     << f.correct << " correct, " << f.wrong_fixes << " wrong fixes; latency median "
     << f.latency_s_median << " s / " << f.latency_m_median << " m, p95 " << f.latency_s_p95
-    << " s / " << f.latency_m_p95 << " m; at most " << f.max_hypotheses << " hypotheses";
+    << " s / " << f.latency_m_p95 << " m; at most " << f.max_hypotheses << " hypotheses; oracle "
+    << "decided " << f.oracle_decided << ", fixed within its distance + 10 m "
+    << f.within_oracle_10m << ", travel past it median " << f.past_oracle_m_median << " m, p95 "
+    << f.past_oracle_m_p95 << " m";
   return s.str();
 }
 

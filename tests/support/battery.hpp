@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -40,6 +41,10 @@ struct EpisodeResult {
   double unsure_s = 0;
   std::size_t unsure_frames = 0, unsure_hypotheses = 0;
   std::string last_why;  // the localizer's last word when it never fixed
+  // The map oracle on the drive from the kidnap (or start) on: the travel after which no other
+  // place fits the lamps seen (sim::MapOracle); empty when a twin fits the whole drive.
+  std::optional<double> oracle_m;
+  std::size_t oracle_twins = 0;  // places the first view fit, the truth excluded
 };
 
 struct BatteryOptions {
@@ -52,6 +57,9 @@ struct BatteryOptions {
   double max_travel_m = 300.0;          // after the kidnap / start, at most
   double after_fix_s = 10.0;            // driven on after the first fix, to catch a wrong one
   sim::LampSensorOptions sensors;
+  // Judge each drive with the map oracle, its view the lamps the omni camera places within the
+  // oracle's tolerance (LampSensors::omni_resolving_radius_m).
+  bool oracle = true;
   // Called after each frame the localizer took (for looking into a failing episode).
   std::function<void(double t, const Pose2& truth, const fusion::Localizer&)> trace;
 };
@@ -87,6 +95,11 @@ struct BatteryFigures {
   double latency_s_median = 0, latency_s_p95 = 0, latency_m_median = 0, latency_m_p95 = 0;
   std::size_t max_hypotheses = 0;
   double unsure_us_per_frame = 0, unsure_mean_hypotheses = 0;
+  // Against the map oracle: episodes it decided within the drive, episodes fixed right within
+  // its distance plus 10 m (the target; an oracle undecided when the drive ended decides after
+  // the fix), and the travel past it (fixed episodes it decided; negative: fixed before it).
+  int oracle_decided = 0, within_oracle_10m = 0;
+  double past_oracle_m_median = 0, past_oracle_m_p95 = 0;
 };
 BatteryFigures figures(const std::vector<EpisodeResult>& results);
 

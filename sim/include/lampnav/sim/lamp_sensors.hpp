@@ -42,6 +42,11 @@ class LampSensors {
 
   vision::OmniDetection omni(const Pose2& pose, std::mt19937_64& rng) const;
   std::vector<vision::LampDetection> ceiling(const Pose2& pose, std::mt19937_64& rng) const;
+  // How far (horizontally, m) the omni camera places the highest lamps within `tolerance_m`,
+  // given its direction noise (3 sigma): the view the map oracle may fairly assume. A blob's
+  // direction error d(theta) moves its lamp by h d(theta) / cos^2(theta) on the ceiling, so far
+  // lamps, near the horizon, are seen but not placed. 0 without an omni camera.
+  double omni_resolving_radius_m(double tolerance_m) const;
 
  private:
   struct Impl;
