@@ -10,6 +10,8 @@ packages=(
   # libraries
   libeigen3-dev libboost-graph-dev libopencv-dev libvisp-dev nlohmann-json3-dev libcli11-dev
   libcairo2-dev libzstd-dev
+  # least squares for map building (mapping/)
+  libceres-dev
   # tests and benchmarks; Chromium opens the report headless in a test
   libgtest-dev libgmock-dev libbenchmark-dev chromium
 )

@@ -1,0 +1,107 @@
+#pragma once
+// Lamp SLAM from a drive: robot poses at keyframes of the ceiling camera and the lamps as
+// landmarks (x, y, height, yaw), estimated together by nonlinear least squares (Ceres Solver) from
+// the wheels and the ceiling camera's lamp detections. The map frame is the robot's start pose.
+//
+// Front end: a keyframe every `keyframe_m` of travel; each lamp the detector saw whole is placed on
+// the ceiling from the current estimate of the pose and joins the nearest landmark of its kind
+// within `gate_m`, or starts a new one. The pose estimate is the dead reckoning corrected by the
+// last solve, so a lamp seen again after a loop is placed with the loop's drift only since then.
+// Back end (src/back_end.cpp): odometry factors between keyframes from the wheel noise model,
+// reprojection factors on the lamps' centres in undistorted normalized coordinates (the detector's
+// output), and orientation factors for rectangular lamps; a Huber loss on the camera terms. The
+// problem is solved again every `solve_every_m` of travel (the last `window_m` of the drive; all
+// of it when a loop has closed, at most every `whole_every_m`) and at the end.
+
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+#include "lampnav/core/pose2.hpp"
+#include "lampnav/core/robot_description.hpp"
+#include "lampnav/core/time.hpp"
+#include "lampnav/graph/map.hpp"
+#include "lampnav/vision/lamp_detector.hpp"
+
+namespace lampnav::mapping {
+
+struct LampMapperOptions {
+  double gate_m = 0.5;          // a lamp joins a landmark this close on the ceiling
+  double height_guess_m = 2.7;  // a new lamp's height above the floor before the solver's
+  double keyframe_m = 0.1;      // travel (m, the turning arc counted) between keyframes
+  double solve_every_m = 5.0;   // travel between two solves
+  double window_m = 30.0;       // a solve moves only the last this much of the drive, unless
+                                // a loop closed since the last whole solve and that was at
+  double whole_every_m = 50.0;  // least this far back (then all of it)
+  // A lamp centre's noise (px, at the camera's focal length): the detector's fraction of a pixel
+  // and the floor's bumps, which tilt the camera by half a degree (2 cm on the ceiling).
+  double pixel_sigma_px = 3.0;
+  double orientation_sigma = 0.005;        // rad, a rectangular lamp's axis in the image
+  double odometry_sigma_per_m = 0.004;     // m per sqrt(m) of travel, each of x and y
+  double odometry_yaw_sigma_per_m = 0.01;  // rad per sqrt(m) of travel
+  double wheel_scale_sigma = 0.01;         // prior on the wheels' relative scale difference (at 0)
+  // Rectangular lamps mounted square to the building (their axes 90 degrees apart): holds the
+  // heading along corridors driven once. Turn off for buildings whose lamps are not.
+  bool square_lamps = true;
+  double square_sigma = 0.01;  // rad, how square
+  // Lamps of one kind hang at one height, within this (m; Huber beyond it). 0: each its own.
+  double shared_height_sigma = 0.01;
+  double huber_sigmas = 3.0;  // the camera terms' loss turns linear beyond this many sigmas
+  int min_sightings = 5;      // a landmark seen at fewer keyframes is dropped (a glint)
+  double merge_m = 0.3;       // landmarks of one kind this close after solving are one lamp
+  int max_iterations = 50;    // per solve
+  // A lamp seen again after 20 m away joins its landmark (closing the loop). Off: it starts a
+  // new one, as mapping without loop closure would (for comparison: docs/mapping.md).
+  bool close_loops = true;
+  void validate() const;  // throws InputError naming the field
+};
+
+// A lamp of the built map, in the map frame (the drive's start).
+struct MappedLamp {
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();  // centre; z above the floor
+  double yaw = 0;                                 // rad, the long axis (rectangles)
+  graph::LampShape shape = graph::LampShape::rectangle;
+  double length = 0, width = 0;  // m, the median of the sightings' sizes
+  int sightings = 0;             // keyframes that saw it
+};
+
+struct KeyframePose {
+  Stamp stamp;
+  Pose2 pose;           // optimized, map frame
+  Pose2 dead_reckoned;  // the wheels alone, from the same start
+  double travel_m = 0;  // from the start
+};
+
+struct MappingResult {
+  std::vector<MappedLamp> lamps;
+  std::vector<KeyframePose> keyframes;
+  std::size_t sightings = 0;            // lamp observations in the problem
+  std::size_t revisits = 0;             // sightings of a landmark after 20 m away from it
+  std::size_t dropped = 0, merged = 0;  // landmarks dropped (too few sightings) and merged
+  int solves = 0;
+  double solve_seconds = 0;  // in Ceres, all solves
+  double final_rms_px = 0;   // reprojection RMS of the last solve
+};
+
+class LampMapper {
+ public:
+  // The robot's `ceiling_camera` (its mount gives the geometry, fx the pixel scale) and wheel
+  // base; throws InputError for bad options or a robot without a ceiling camera.
+  LampMapper(const RobotDescription& robot, const LampMapperOptions& options = {});
+  ~LampMapper();
+  LampMapper(LampMapper&&) noexcept;
+
+  // Cumulative travel of each wheel (m), read at `stamp`, in time order.
+  void wheels(Stamp stamp, double left, double right);
+  // The lamps the detector found in a ceiling frame captured at `stamp` (at most as late as the
+  // wheels' last reading). Only lamps seen whole are used.
+  void ceiling(Stamp stamp, const std::vector<vision::LampDetection>& lamps);
+  // Solves a last time, merges and drops landmarks, and gives the map's lamps and the drive.
+  MappingResult finish();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace lampnav::mapping

@@ -1,0 +1,243 @@
+#include "back_end.hpp"
+
+#include <ceres/ceres.h>
+
+#include <chrono>
+#include <cmath>
+
+namespace lampnav::mapping {
+
+namespace {
+
+// Odometry between two keyframes: the relative pose the wheels measured (one arc of a
+// differential drive, the right wheel's travel times 1 + d and the left's times 1 - d), against
+// the one the estimates give, weighted by the noise of that much travel. Estimating d takes out
+// the curving drift of one wheel a few tenths of a percent larger than the other. The common
+// scale is not estimated: a camera looking up cannot tell a building from a smaller one with a
+// lower ceiling, so the wheels' calibration sets the map's scale.
+struct OdometryFactor {
+  OdometryFactor(double d_left, double d_right, double semi_axis, double sigma_xy, double sigma_yaw)
+      : dl(d_left), dr(d_right), b(semi_axis), sxy(sigma_xy), syaw(sigma_yaw) {}
+
+  template <class T>
+  bool operator()(const T* a, const T* c2, const T* scale, T* r) const {
+    using std::cos;
+    using std::sin;
+    const T l = (T(1) - scale[0]) * T(dl), rr = (T(1) + scale[0]) * T(dr);
+    const T ds = (l + rr) / T(2), dth = (rr - l) / T(2 * b);
+    const T mx = ds * cos(dth / T(2)), my = ds * sin(dth / T(2));
+    const T c = cos(a[2]), s = sin(a[2]);
+    const T ex = c2[0] - a[0], ey = c2[1] - a[1];
+    const T lx = c * ex + s * ey;  // the second keyframe in the first's frame
+    const T ly = -s * ex + c * ey;
+    T e = c2[2] - a[2] - dth;
+    e = atan2(sin(e), cos(e));  // wrapped, smoothly
+    r[0] = (lx - mx) / T(sxy);
+    r[1] = (ly - my) / T(sxy);
+    r[2] = e / T(syaw);
+    return true;
+  }
+  double dl, dr, b, sxy, syaw;
+};
+
+// Lamps mounted square to the building: a rectangular lamp's axis is the building's axis, or
+// at right angles to it (modulo 90 degrees). A Manhattan-world prior, as indoor SLAM uses; it
+// holds the heading where the wheels alone would drift along a corridor never driven twice.
+struct SquareFactor {
+  explicit SquareFactor(double sigma) : sigma_rad(sigma) {}
+  template <class T>
+  bool operator()(const T* lamp, const T* axis, T* r) const {
+    const T e = T(4) * (lamp[3] - axis[0]);
+    r[0] = atan2(sin(e), cos(e)) / T(4) / T(sigma_rad);
+    return true;
+  }
+  double sigma_rad;
+};
+
+// Lamps of one kind hang at one height (a flat ceiling), robustly: a lamp the drive saw from
+// one side only, or while turning on the spot, borrows the height of its kind; one truly higher
+// pays a bounded price (Huber) and keeps its own.
+struct HeightFactor {
+  explicit HeightFactor(double sigma) : s(sigma) {}
+  template <class T>
+  bool operator()(const T* lamp, const T* height, T* r) const {
+    r[0] = (lamp[2] - height[0]) / T(s);
+    return true;
+  }
+  double s;
+};
+
+// The wheels differ little: d stays near 0.
+struct ScalePrior {
+  explicit ScalePrior(double sigma) : s(sigma) {}
+  template <class T>
+  bool operator()(const T* scale, T* r) const {
+    r[0] = scale[0] / T(s);
+    return true;
+  }
+  double s;
+};
+
+// A lamp's centre in the ceiling image: predicted by the camera geometry shared with the
+// localizer (numeric derivatives: one model, not a copy of it templated for autodiff).
+struct CentreFactor {
+  CentreFactor(const fusion::CeilingGeometry& g, const Eigen::Vector2d& n, double sigma)
+      : geometry(&g), measured(n), sigma_n(sigma) {}
+  bool operator()(const double* pose, const double* lamp, double* r) const {
+    const auto p = geometry->predict(Pose2(pose[0], pose[1], pose[2]),
+                                     Eigen::Vector3d(lamp[0], lamp[1], lamp[2]));
+    if (!p) return false;
+    r[0] = (p->x() - measured.x()) / sigma_n;
+    r[1] = (p->y() - measured.y()) / sigma_n;
+    return true;
+  }
+  const fusion::CeilingGeometry* geometry;
+  Eigen::Vector2d measured;
+  double sigma_n;
+};
+
+// A rectangular lamp's axis in the image (modulo pi).
+struct AxisFactor {
+  AxisFactor(const fusion::CeilingGeometry& g, double orientation, double sigma)
+      : geometry(&g), measured(orientation), sigma_rad(sigma) {}
+  bool operator()(const double* pose, const double* lamp, double* r) const {
+    const auto o = geometry->predict_orientation(
+        Pose2(pose[0], pose[1], pose[2]), Eigen::Vector3d(lamp[0], lamp[1], lamp[2]), lamp[3]);
+    if (!o) return false;
+    r[0] = wrap_angle(2 * (*o - measured)) / 2 / sigma_rad;
+    return true;
+  }
+  const fusion::CeilingGeometry* geometry;
+  double measured, sigma_rad;
+};
+
+}  // namespace
+
+SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
+                  const LampMapperOptions& o, double focal_px, std::size_t first_free) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const bool whole = first_free == 0;
+  // The lamps the free keyframes see; their other sightings anchor them to the fixed past.
+  std::vector<bool> in_window(pb.lamps.size(), whole);
+  for (const auto& s : pb.sightings)
+    if (static_cast<std::size_t>(s.keyframe) >= first_free) in_window[s.lamp] = true;
+
+  ceres::Problem::Options po;
+  po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  ceres::Problem problem(po);
+  ceres::HuberLoss huber(o.huber_sigmas);
+  auto add_pose = [&](std::size_t k) {
+    double* p = pb.poses[k].data();
+    if (problem.HasParameterBlock(p)) return;
+    problem.AddParameterBlock(p, 3);
+    if (k == 0 || k < first_free) problem.SetParameterBlockConstant(p);
+  };
+
+  problem.AddParameterBlock(&pb.wheel_difference, 1);
+  problem.AddResidualBlock(
+      new ceres::AutoDiffCostFunction<ScalePrior, 1, 1>(new ScalePrior(o.wheel_scale_sigma)),
+      nullptr, &pb.wheel_difference);
+  if (!whole) problem.SetParameterBlockConstant(&pb.wheel_difference);
+  for (std::size_t k = std::max<std::size_t>(1, first_free); k < pb.poses.size(); ++k) {
+    const double d = std::max(1e-3, pb.travel[k] - pb.travel[k - 1]);
+    const double sxy = std::max(5e-4, o.odometry_sigma_per_m * std::sqrt(d));
+    const double syaw = std::max(2e-4, o.odometry_yaw_sigma_per_m * std::sqrt(d));
+    add_pose(k - 1);
+    add_pose(k);
+    problem.AddResidualBlock(
+        new ceres::AutoDiffCostFunction<OdometryFactor, 3, 3, 3, 1>(
+            new OdometryFactor(pb.wheels[k][0] - pb.wheels[k - 1][0],
+                               pb.wheels[k][1] - pb.wheels[k - 1][1], pb.semi_axis, sxy, syaw)),
+        nullptr, pb.poses[k - 1].data(), pb.poses[k].data(), &pb.wheel_difference);
+  }
+  // One shared height per kind of lamp (rectangles, discs): estimated by a whole solve, held by
+  // a windowed one.
+  double kind_height[2] = {0, 0};
+  int kind_count[2] = {0, 0};
+  for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
+    kind_height[pb.rectangle[i] ? 0 : 1] += pb.lamps[i][2];
+    ++kind_count[pb.rectangle[i] ? 0 : 1];
+  }
+  ceres::HuberLoss height_loss(1.0);
+  if (o.shared_height_sigma > 0) {
+    for (int k = 0; k < 2; ++k)
+      if (kind_count[k]) kind_height[k] /= kind_count[k];
+    for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
+      if (!in_window[i]) continue;
+      problem.AddResidualBlock(new ceres::AutoDiffCostFunction<HeightFactor, 1, 4, 1>(
+                                   new HeightFactor(o.shared_height_sigma)),
+                               &height_loss, pb.lamps[i].data(),
+                               &kind_height[pb.rectangle[i] ? 0 : 1]);
+    }
+    for (int k = 0; k < 2; ++k) {
+      if (!whole && problem.HasParameterBlock(&kind_height[k]))
+        problem.SetParameterBlockConstant(&kind_height[k]);
+    }
+  }
+  bool any_rectangle = false;
+  if (o.square_lamps) {
+    for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
+      if (!pb.rectangle[i] || !in_window[i]) continue;
+      any_rectangle = true;
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<SquareFactor, 1, 4, 1>(new SquareFactor(o.square_sigma)),
+          nullptr, pb.lamps[i].data(), &pb.square_yaw);
+    }
+  }
+  if (any_rectangle && whole) {
+    // The building's axis is fixed by the first lamps' yaws; keep it from wandering by 90 deg.
+    problem.SetParameterLowerBound(&pb.square_yaw, 0, pb.square_yaw - M_PI / 4);
+    problem.SetParameterUpperBound(&pb.square_yaw, 0, pb.square_yaw + M_PI / 4);
+  } else if (any_rectangle) {
+    problem.SetParameterBlockConstant(&pb.square_yaw);
+  }
+  const double sigma_n = o.pixel_sigma_px / focal_px;
+  std::vector<bool> has_axis(pb.lamps.size(), false);
+  std::vector<const MappingProblem::Sighting*> used;
+  for (const auto& s : pb.sightings) {
+    if (!in_window[s.lamp]) continue;
+    used.push_back(&s);
+    add_pose(s.keyframe);
+    problem.AddResidualBlock(
+        new ceres::NumericDiffCostFunction<CentreFactor, ceres::CENTRAL, 2, 3, 4>(
+            new CentreFactor(geometry, s.centre, sigma_n)),
+        &huber, pb.poses[s.keyframe].data(), pb.lamps[s.lamp].data());
+    if (pb.rectangle[s.lamp]) {
+      has_axis[s.lamp] = true;
+      problem.AddResidualBlock(
+          new ceres::NumericDiffCostFunction<AxisFactor, ceres::CENTRAL, 1, 3, 4>(
+              new AxisFactor(geometry, s.orientation, o.orientation_sigma)),
+          &huber, pb.poses[s.keyframe].data(), pb.lamps[s.lamp].data());
+    }
+  }
+  // A disc has no axis: its yaw is not in the problem.
+  for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
+    if (in_window[i] && !has_axis[i] && problem.HasParameterBlock(pb.lamps[i].data()))
+      problem.SetManifold(pb.lamps[i].data(), new ceres::SubsetManifold(4, {3}));
+  }
+
+  ceres::Solver::Options so;
+  so.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+  so.max_num_iterations = o.max_iterations;
+  so.num_threads = 2;
+  so.logging_type = ceres::SILENT;
+  ceres::Solver::Summary summary;
+  ceres::Solve(so, &problem, &summary);
+
+  SolveReport rep;
+  double sum = 0;
+  std::size_t n = 0;
+  for (const auto* s : used) {
+    const auto& q = pb.poses[s->keyframe];
+    const auto& l = pb.lamps[s->lamp];
+    const auto p = geometry.predict(Pose2(q[0], q[1], q[2]), Eigen::Vector3d(l[0], l[1], l[2]));
+    if (!p) continue;
+    sum += ((*p - s->centre) * focal_px).squaredNorm();
+    ++n;
+  }
+  rep.rms_px = n ? std::sqrt(sum / n) : 0.0;
+  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return rep;
+}
+
+}  // namespace lampnav::mapping

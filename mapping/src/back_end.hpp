@@ -1,0 +1,44 @@
+#pragma once
+// The mapper's least-squares problem and its solve with Ceres Solver. Private to mapping/: Ceres
+// stays out of every header.
+
+#include <array>
+#include <vector>
+
+#include "lampnav/core/pose2.hpp"
+#include "lampnav/fusion/ceiling_geometry.hpp"
+#include "lampnav/mapping/lamp_mapper.hpp"
+
+namespace lampnav::mapping {
+
+struct MappingProblem {
+  std::vector<std::array<double, 3>> poses;   // keyframes (x, y, yaw), map frame: estimated
+  std::vector<Pose2> odometry;                // dead reckoning at each keyframe
+  std::vector<std::array<double, 2>> wheels;  // cumulative wheel travel (left, right) at each
+  double semi_axis = 0.2;                     // m
+  double wheel_difference = 0;                // estimated: right wheel 1 + d, left 1 - d
+  double square_yaw = 0;                      // estimated: the building's axis (mod 90 degrees)
+  std::vector<double> travel;                 // m from the start at each keyframe
+  std::vector<std::array<double, 4>> lamps;   // landmarks (x, y, z, yaw): estimated
+  std::vector<bool> rectangle;                // per landmark
+  struct Sighting {
+    int keyframe = 0, lamp = 0;
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();  // undistorted normalized
+    double orientation = 0;                            // rad, image axis (rectangles)
+  };
+  std::vector<Sighting> sightings;
+};
+
+struct SolveReport {
+  double seconds = 0;
+  double rms_px = 0;  // reprojection RMS over the sightings, in pixels
+};
+
+// Solves the problem in place; the first keyframe is held fixed (it is the map frame). With
+// `first_free` > 0 only the keyframes from it on and the lamps they see move (their sightings
+// from earlier keyframes anchor them); the wheels, the building's axis and the shared heights
+// are held.
+SolveReport solve(MappingProblem& problem, const fusion::CeilingGeometry& geometry,
+                  const LampMapperOptions& options, double focal_px, std::size_t first_free = 0);
+
+}  // namespace lampnav::mapping

@@ -1,0 +1,297 @@
+#include "lampnav/mapping/lamp_mapper.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <optional>
+
+#include "back_end.hpp"
+#include "lampnav/core/error.hpp"
+#include "lampnav/fusion/ceiling_geometry.hpp"
+#include "lampnav/fusion/odometry_track.hpp"
+
+namespace lampnav::mapping {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+
+void LampMapperOptions::validate() const {
+  auto check = [](bool ok, const char* field, const char* what) {
+    if (!ok) throw InputError({"lamp mapper options", "", field}, what);
+  };
+  check(gate_m > 0 && gate_m < 5, "gate_m", "must be 0 to 5 m");
+  check(height_guess_m > 0 && height_guess_m < 50, "height_guess_m", "must be 0 to 50 m");
+  check(keyframe_m > 0 && keyframe_m < 10, "keyframe_m", "must be 0 to 10 m");
+  check(solve_every_m > 0, "solve_every_m", "must be positive");
+  check(pixel_sigma_px > 0, "pixel_sigma_px", "must be positive");
+  check(orientation_sigma > 0, "orientation_sigma", "must be positive");
+  check(odometry_sigma_per_m > 0, "odometry_sigma_per_m", "must be positive");
+  check(odometry_yaw_sigma_per_m > 0, "odometry_yaw_sigma_per_m", "must be positive");
+  check(huber_sigmas > 0, "huber_sigmas", "must be positive");
+  check(wheel_scale_sigma > 0 && wheel_scale_sigma < 0.5, "wheel_scale_sigma", "must be 0 to 0.5");
+  check(square_sigma > 0, "square_sigma", "must be positive");
+  check(shared_height_sigma >= 0, "shared_height_sigma", "must not be negative");
+  check(min_sightings >= 1, "min_sightings", "must be at least 1");
+  check(merge_m >= 0 && merge_m < gate_m + 1, "merge_m", "must be 0 to the gate plus 1 m");
+  check(max_iterations >= 1, "max_iterations", "must be at least 1");
+  check(window_m > 0, "window_m", "must be positive");
+  check(whole_every_m > 0, "whole_every_m", "must be positive");
+}
+
+// A landmark seen again after this much travel away from it closes a loop.
+constexpr double kRevisitM = 20.0;
+
+struct LampMapper::Impl {
+  LampMapperOptions o;
+  CameraDescription camera;
+  fusion::CeilingGeometry geometry;
+  double focal_px;
+  fusion::OdometryTrack track;
+  std::optional<std::pair<double, double>> last_wheels;
+  std::vector<std::pair<Stamp, std::array<double, 2>>> wheel_log;  // cumulative readings
+  MappingProblem pb;
+  std::vector<Stamp> stamps;               // per keyframe
+  std::vector<std::vector<double>> sizes;  // per landmark: (length, width) sightings
+  std::vector<std::vector<double>> widths;
+  std::vector<double> last_seen_travel;  // per landmark
+  double next_solve_m;
+  bool square_set = false;
+  bool revisited = false;  // a landmark seen again after a loop since the last whole solve
+  double last_whole_m = -1e9;
+  MappingResult result;
+
+  Impl(const RobotDescription& robot, const LampMapperOptions& options)
+      : o(options),
+        camera(ceiling_of(robot)),
+        geometry(camera),
+        focal_px(camera.model == CameraModelKind::pinhole ? camera.pinhole.fx : 300.0),
+        track(robot.semi_axis, std::chrono::hours(24 * 365)),
+        next_solve_m(options.solve_every_m) {
+    o.validate();
+    pb.semi_axis = robot.semi_axis;
+  }
+
+  static CameraDescription ceiling_of(const RobotDescription& robot) {
+    const CameraDescription* c = robot.find_camera("ceiling_camera");
+    if (!c)
+      throw InputError({"robot.json", "", "cameras"},
+                       "no camera named \"ceiling_camera\": the map is built from its lamps");
+    return *c;
+  }
+
+  // The pose estimate at a dead-reckoned pose: the dead reckoning, corrected by the last
+  // keyframe's solved pose.
+  Pose2 estimate(const Pose2& odometry) const {
+    if (pb.poses.empty()) return odometry;
+    const auto& q = pb.poses.back();
+    const Pose2 solved(q[0], q[1], q[2]);
+    return solved * pb.odometry.back().between(odometry);
+  }
+
+  double travel_at(Stamp t) const { return track.travel(track.first_stamp(), t); }
+
+  // Cumulative wheel travel at `t`, interpolated between readings.
+  std::array<double, 2> wheels_at(Stamp t) const {
+    auto it = std::lower_bound(wheel_log.begin(), wheel_log.end(), t,
+                               [](const auto& w, Stamp s) { return w.first < s; });
+    if (it == wheel_log.end()) return wheel_log.back().second;
+    if (it == wheel_log.begin() || it->first == t) return it->second;
+    const auto& a = *(it - 1);
+    const double f = to_seconds(t - a.first) / to_seconds(it->first - a.first);
+    return {a.second[0] + f * (it->second[0] - a.second[0]),
+            a.second[1] + f * (it->second[1] - a.second[1])};
+  }
+
+  void add_frame(Stamp t, const std::vector<vision::LampDetection>& lamps) {
+    if (track.empty()) return;
+    const Pose2 odo = track.at(t);
+    const double travel = travel_at(t);
+    const bool first = pb.poses.empty();
+    if (!first && travel - pb.travel.back() < o.keyframe_m) return;
+    const Pose2 est = estimate(odo);
+    const int kf = static_cast<int>(pb.poses.size());
+    pb.poses.push_back({est.x(), est.y(), est.yaw()});
+    pb.odometry.push_back(odo);
+    pb.wheels.push_back(wheels_at(t));
+    pb.travel.push_back(travel);
+    stamps.push_back(t);
+    const Vector3d& cam = geometry.mount_origin();
+    std::vector<bool> taken(pb.lamps.size(), false);
+    for (const auto& d : lamps) {
+      if (d.view != vision::LampView::full) continue;
+      // Where the lamp is on the ceiling, at the height of what it joins (or the guess).
+      const double z0 = o.height_guess_m;
+      const auto base = geometry.base_point(d.centre, z0);
+      if (!base) continue;
+      const Vector2d at = est.transform_from(*base);
+      const double range = z0 - cam.z();
+      const double length = d.length * range, width = d.width * range;
+      const bool rect = length > 1.5 * width;
+      int best = -1;
+      double best_d = o.gate_m;
+      for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
+        if (taken[i] || pb.rectangle[i] != rect) continue;
+        if (!o.close_loops && travel - last_seen_travel[i] > kRevisitM) continue;
+        // Place the candidate with its own height: parallax matters at a metre of offset.
+        const auto b = geometry.base_point(d.centre, pb.lamps[i][2]);
+        if (!b) continue;
+        const Vector2d p = est.transform_from(*b);
+        const double dist = (p - Vector2d(pb.lamps[i][0], pb.lamps[i][1])).norm();
+        if (dist < best_d) {
+          best_d = dist;
+          best = static_cast<int>(i);
+        }
+      }
+      if (best < 0) {
+        best = static_cast<int>(pb.lamps.size());
+        double yaw = 0;
+        if (rect) {
+          if (const auto dir = geometry.base_direction(d.centre, d.orientation, z0))
+            yaw = wrap_angle(*dir + est.yaw());
+        }
+        if (rect && !square_set) {
+          pb.square_yaw = yaw;
+          square_set = true;
+        }
+        pb.lamps.push_back({at.x(), at.y(), z0, yaw});
+        pb.rectangle.push_back(rect);
+        sizes.emplace_back();
+        widths.emplace_back();
+        last_seen_travel.push_back(travel);
+        taken.push_back(false);
+      }
+      taken[best] = true;
+      if (travel - last_seen_travel[best] > kRevisitM) {
+        ++result.revisits;
+        revisited = true;
+      }
+      last_seen_travel[best] = travel;
+      sizes[best].push_back(length);
+      widths[best].push_back(width);
+      pb.sightings.push_back({kf, best, d.centre, d.orientation});
+    }
+    if (travel >= next_solve_m) {
+      // A loop closed since the last solve moves the whole drive; otherwise only the last
+      // stretch is free.
+      std::size_t first_free = 0;
+      if (!revisited || travel < last_whole_m + o.whole_every_m) {
+        first_free = pb.travel.size();
+        while (first_free > 1 && pb.travel[first_free - 1] > travel - o.window_m) --first_free;
+      }
+      run_solve(first_free);
+      if (first_free == 0) {
+        revisited = false;
+        last_whole_m = travel;
+      }
+      next_solve_m = travel + o.solve_every_m;
+    }
+  }
+
+  void run_solve(std::size_t first_free = 0, int iterations = 0) {
+    if (pb.poses.size() < 2) return;
+    LampMapperOptions so = o;
+    if (iterations > 0) so.max_iterations = iterations;
+    const SolveReport r = solve(pb, geometry, so, focal_px, first_free);
+    ++result.solves;
+    result.solve_seconds += r.seconds;
+    result.final_rms_px = r.rms_px;
+  }
+};
+
+LampMapper::LampMapper(const RobotDescription& robot, const LampMapperOptions& options)
+    : impl_(std::make_unique<Impl>(robot, options)) {}
+LampMapper::~LampMapper() = default;
+LampMapper::LampMapper(LampMapper&&) noexcept = default;
+
+void LampMapper::wheels(Stamp stamp, double left, double right) {
+  Impl& m = *impl_;
+  if (!std::isfinite(left) || !std::isfinite(right)) return;
+  if (!m.wheel_log.empty() && stamp <= m.wheel_log.back().first) return;
+  if (!m.last_wheels) {
+    m.track.add(stamp, 0, 0);
+  } else {
+    m.track.add(stamp, left - m.last_wheels->first, right - m.last_wheels->second);
+  }
+  m.last_wheels = {left, right};
+  m.wheel_log.push_back({stamp, {left, right}});
+}
+
+void LampMapper::ceiling(Stamp stamp, const std::vector<vision::LampDetection>& lamps) {
+  impl_->add_frame(stamp, lamps);
+}
+
+namespace {
+double median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+}  // namespace
+
+MappingResult LampMapper::finish() {
+  Impl& m = *impl_;
+  MappingProblem& pb = m.pb;
+  m.run_solve(0, 4 * m.o.max_iterations);
+  // Landmarks of one kind that the solve brought together are one lamp (a lamp first seen again
+  // with more drift than the gate): their sightings move to the first, and the problem is solved
+  // again.
+  std::vector<int> into(pb.lamps.size(), -1);
+  std::vector<int> count(pb.lamps.size(), 0);
+  for (const auto& s : pb.sightings) ++count[s.lamp];
+  bool merged = false;
+  for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
+    if (into[i] >= 0) continue;
+    for (std::size_t j = i + 1; j < pb.lamps.size(); ++j) {
+      if (into[j] >= 0 || pb.rectangle[i] != pb.rectangle[j]) continue;
+      const Vector2d d(pb.lamps[i][0] - pb.lamps[j][0], pb.lamps[i][1] - pb.lamps[j][1]);
+      if (d.norm() < m.o.merge_m && m.o.close_loops) {
+        into[j] = static_cast<int>(i);
+        ++m.result.merged;
+        merged = true;
+      }
+    }
+  }
+  if (merged && m.o.close_loops) {
+    for (auto& s : pb.sightings) {
+      if (into[s.lamp] >= 0) {
+        const int to = into[s.lamp];
+        m.sizes[to].insert(m.sizes[to].end(), m.sizes[s.lamp].begin(), m.sizes[s.lamp].end());
+        m.widths[to].insert(m.widths[to].end(), m.widths[s.lamp].begin(), m.widths[s.lamp].end());
+        m.sizes[s.lamp].clear();
+        m.widths[s.lamp].clear();
+        s.lamp = to;
+      }
+    }
+    m.run_solve();
+  }
+  // Sightings per landmark, counted by keyframe.
+  std::vector<int> seen(pb.lamps.size(), 0);
+  for (const auto& s : pb.sightings) ++seen[s.lamp];
+  MappingResult& out = m.result;
+  out.sightings = pb.sightings.size();
+  for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
+    if (into[i] >= 0) continue;
+    if (seen[i] < m.o.min_sightings) {
+      ++out.dropped;
+      continue;
+    }
+    MappedLamp l;
+    l.xyz = Vector3d(pb.lamps[i][0], pb.lamps[i][1], pb.lamps[i][2]);
+    l.shape = pb.rectangle[i] ? graph::LampShape::rectangle : graph::LampShape::disc;
+    // Sizes were measured at the guessed height: rescale to the solved one.
+    const double scale = (l.xyz.z() - m.geometry.mount_origin().z()) /
+                         (m.o.height_guess_m - m.geometry.mount_origin().z());
+    l.length = median(m.sizes[i]) * scale;
+    l.width = pb.rectangle[i] ? median(m.widths[i]) * scale : l.length;
+    l.yaw = pb.rectangle[i] ? wrap_angle(2 * pb.lamps[i][3]) / 2 : 0.0;
+    l.sightings = seen[i];
+    out.lamps.push_back(l);
+  }
+  for (std::size_t k = 0; k < pb.poses.size(); ++k) {
+    out.keyframes.push_back({m.stamps[k], Pose2(pb.poses[k][0], pb.poses[k][1], pb.poses[k][2]),
+                             pb.odometry[k], pb.travel[k]});
+  }
+  return out;
+}
+
+}  // namespace lampnav::mapping

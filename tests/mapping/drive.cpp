@@ -1,0 +1,52 @@
+#include "drive.hpp"
+
+#include <cmath>
+
+namespace lampnav::test {
+
+DriveRecord drive_through(const std::vector<Eigen::Vector2d>& waypoints, double start_yaw,
+                          const sim::LampSensors& sensors, double semi_axis,
+                          const DriveOptions& o) {
+  DriveRecord rec;
+  std::mt19937_64 rng(o.seed);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  Pose2 truth(waypoints.front(), start_yaw);
+  rec.start = truth;
+  const double dt = 0.02;
+  double t = 0, left = 0, right = 0, next_frame = 0.01;
+  auto stamp = [](double s) { return Stamp(std::chrono::nanoseconds(std::llround(s * 1e9))); };
+  auto step = [&](double v, double w) {
+    truth = truth * Pose2(v * dt, 0.0, w * dt);
+    const double dl = (v - w * semi_axis) * dt, dr = (v + w * semi_axis) * dt;
+    left += dl * (1 + o.scale_error_left) + o.wheel_noise * std::sqrt(std::abs(dl)) * n01(rng);
+    right += dr * (1 + o.scale_error_right) + o.wheel_noise * std::sqrt(std::abs(dr)) * n01(rng);
+    rec.length_m += 0.5 * (std::abs(dl) + std::abs(dr));
+    t += dt;
+    rec.wheels.push_back({stamp(t), left, right});
+    if (t >= next_frame) {
+      next_frame += 1.0 / o.ceiling_rate;
+      rec.frames.push_back({stamp(t), truth, sensors.ceiling(truth, rng)});
+    }
+  };
+  rec.wheels.push_back({stamp(0), 0, 0});
+  for (std::size_t i = 1; i < waypoints.size(); ++i) {
+    const Eigen::Vector2d d = waypoints[i] - truth.translation();
+    const double heading = std::atan2(d.y(), d.x());
+    double turn = wrap_angle(heading - truth.yaw());
+    while (std::abs(turn) > o.turn_rate * dt) {
+      step(0, turn > 0 ? o.turn_rate : -o.turn_rate);
+      turn = wrap_angle(heading - truth.yaw());
+    }
+    double remaining = (waypoints[i] - truth.translation()).norm();
+    while (remaining > o.speed * dt) {
+      // Steer gently towards the waypoint, as a driver would.
+      const Eigen::Vector2d to = waypoints[i] - truth.translation();
+      const double err = wrap_angle(std::atan2(to.y(), to.x()) - truth.yaw());
+      step(o.speed, std::clamp(2.0 * err, -o.turn_rate, o.turn_rate));
+      remaining = (waypoints[i] - truth.translation()).norm();
+    }
+  }
+  return rec;
+}
+
+}  // namespace lampnav::test

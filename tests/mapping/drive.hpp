@@ -1,0 +1,43 @@
+#pragma once
+// A drive for mapping tests: through waypoints (turn on the spot, then straight), with wheels that
+// have a scale error and noise, and the ideal lamp detections of the ceiling camera at 10 Hz.
+
+#include <random>
+#include <vector>
+
+#include "lampnav/core/pose2.hpp"
+#include "lampnav/core/time.hpp"
+#include "lampnav/sim/lamp_sensors.hpp"
+#include "lampnav/vision/lamp_detector.hpp"
+
+namespace lampnav::test {
+
+struct DriveOptions {
+  double speed = 0.5, turn_rate = 0.6;  // m/s, rad/s
+  double scale_error_left = 0.004, scale_error_right = -0.003;
+  double wheel_noise = 0.002;  // m per sqrt(m)
+  double ceiling_rate = 10;    // Hz
+  std::uint64_t seed = 1;
+};
+
+struct DriveRecord {
+  struct Wheels {
+    Stamp stamp;
+    double left, right;  // cumulative, m, as measured
+  };
+  struct Frame {
+    Stamp stamp;
+    Pose2 truth;
+    std::vector<vision::LampDetection> lamps;
+  };
+  std::vector<Wheels> wheels;
+  std::vector<Frame> frames;
+  Pose2 start;
+  double length_m = 0;
+};
+
+DriveRecord drive_through(const std::vector<Eigen::Vector2d>& waypoints, double start_yaw,
+                          const sim::LampSensors& sensors, double semi_axis,
+                          const DriveOptions& options = {});
+
+}  // namespace lampnav::test
