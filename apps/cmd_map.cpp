@@ -1,4 +1,4 @@
-// lampnav map check | map render
+// lampnav map check | map render (map build: cmd_map_build.cpp)
 
 #include <CLI/CLI.hpp>
 #include <iostream>
@@ -73,8 +73,10 @@ int run_check(const CheckArgs& a) {
 }  // namespace
 
 void add_map_commands(CLI::App& app, Job& run) {
-  CLI::App* map = app.add_subcommand("map", "Validate or draw a map (shared/spec/map-format.md)");
+  CLI::App* map =
+      app.add_subcommand("map", "Validate, draw or build a map (shared/spec/map-format.md)");
   map->require_subcommand(1);
+  add_map_build_command(*map, run);
 
   auto check_args = std::make_shared<CheckArgs>();
   CLI::App* check = map->add_subcommand("check", "Validate a map; print a summary or the errors");

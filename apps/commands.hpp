@@ -16,6 +16,7 @@ namespace lampnav::apps {
 using Job = std::function<int()>;
 
 void add_map_commands(CLI::App& app, Job& run);
+void add_map_build_command(CLI::App& map, Job& run);  // map build (under `map`)
 void add_route_command(CLI::App& app, Job& run);
 void add_sim_command(CLI::App& app, Job& run);
 void add_locate_command(CLI::App& app, Job& run);

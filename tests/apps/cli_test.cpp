@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "cli_support.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav_test.hpp"
 
@@ -15,24 +16,9 @@ namespace {
 
 using ::testing::HasSubstr;
 
-struct Result {
-  int status = -1;
-  std::string out, err;
-};
-
-// Runs lampnav with arguments (shell-quoted by the caller), capturing stdout and stderr.
-Result run(const std::string& args) {
-  const auto dir = std::filesystem::temp_directory_path();
-  const std::string err_file = (dir / ("lampnav_cli_err_" + std::to_string(::getpid()))).string();
-  const std::string cmd = std::string(LAMPNAV_BINARY) + " " + args + " 2>" + err_file;
-  Result r;
-  r.out = test::run_command(cmd, &r.status);
-  r.err = test::slurp(err_file);
-  std::filesystem::remove(err_file);
-  return r;
-}
-
-std::string src(const std::string& rel) { return "'" + test::source_path(rel) + "'"; }
+using Result = test::CliResult;
+Result run(const std::string& args) { return test::run_lampnav(args); }
+std::string src(const std::string& rel) { return test::quoted_source(rel); }
 
 TEST(Cli, MapCheckBundledMapsExitZeroWithSummary) {
   for (const char* m : {"maps/office_floor.geojson", "maps/domus_museum.geojson"}) {

@@ -5,11 +5,11 @@
 
 #include <gtest/gtest.h>
 
-#include <Eigen/Geometry>
 #include <chrono>
 #include <iostream>
 #include <set>
 
+#include "alignment.hpp"
 #include "drive.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/graph/planner.hpp"
@@ -58,26 +58,12 @@ Accuracy compare(const MappingResult& built, const graph::TopologicalMap& truth,
     if (!used.insert(near.front()).second) ++a.doubles;
     pairs.emplace_back(l.xyz.head<2>(), near.front());
   }
-  // The rigid motion (rotation, translation) that best maps the built lamps onto the true ones.
-  Vector2d cs = Vector2d::Zero(), cd = Vector2d::Zero();
-  for (const auto& [p, l] : pairs) {
-    cs += p;
-    cd += l->xyz.head<2>();
-  }
-  cs /= std::max<std::size_t>(1, pairs.size());
-  cd /= std::max<std::size_t>(1, pairs.size());
-  double sc = 0, ss = 0;
-  for (const auto& [p, l] : pairs) {
-    const Vector2d u = p - cs, v = l->xyz.head<2>() - cd;
-    sc += u.dot(v);
-    ss += u.x() * v.y() - u.y() * v.x();
-  }
-  const double th = std::atan2(ss, sc);
-
-  const Eigen::Matrix2d R = Eigen::Rotation2Dd(th).toRotationMatrix();
+  std::vector<std::pair<Vector2d, Vector2d>> point_pairs;
+  for (const auto& [p, l] : pairs) point_pairs.emplace_back(p, l->xyz.head<2>());
+  const test::RigidFit fit = test::fit_rigid(point_pairs);
   double sum = 0;
   for (std::size_t i = 0; i < pairs.size(); ++i) {
-    const Vector2d p = R * (pairs[i].first - cs) + cd;
+    const Vector2d p = fit.apply(pairs[i].first);
     const double e = (p - pairs[i].second->xyz.head<2>()).norm();
     sum += e * e;
     a.max_m = std::max(a.max_m, e);

@@ -1,0 +1,46 @@
+#pragma once
+// The places and connections of a building from a mapped drive (trajectory first, as road maps
+// are inferred from GPS traces): the optimized drive is cut into straight stretches; collinear
+// stretches make corridor lines; where lines meet are places, their kind by the ways out the
+// drive took (one: an end, two at an angle: a corner, three or more: a junction); the pieces of
+// the lines between places are corridors. Each lamp goes to the place whose region holds it, in
+// walking order. What the drive never went down is not in the map: a junction whose third way
+// was never driven comes out a corner.
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include "lampnav/graph/map.hpp"
+#include "lampnav/mapping/lamp_mapper.hpp"
+
+namespace lampnav::mapping {
+
+struct TopologyOptions {
+  double corridor_width_m = 2.0;  // regions' width (the omni view could measure it: not yet)
+  double simplify_m = 0.3;        // the drive's polyline is simplified to this tolerance
+  double min_stretch_m = 1.0;     // shorter straight stretches (turns on the spot) are dropped
+  double same_line_m = 0.6;       // stretches this close across and parallel share a line
+  double parallel_deg = 8.0;
+  double gap_m = 1.5;     // a line's stretches this far apart are one corridor
+  double place_m = 1.5;   // line meetings this close are one place
+  void validate() const;  // throws InputError naming the field
+};
+
+struct TopologyReport {
+  std::size_t lamps_placed = 0;
+  std::size_t lamps_outside = 0;  // lamps in no place's region (left out of the map)
+  std::vector<std::string> notes;
+};
+
+// Names: C1, C2, ... for corridors, J for junctions, K for corners, E for ends, numbered in the
+// order the drive first reached them; `names` maps a point inside a place to the name to use.
+struct PlaceName {
+  Eigen::Vector2d at = Eigen::Vector2d::Zero();
+  std::string name;
+};
+
+graph::TopologicalMap build_topology(const MappingResult& mapped, const TopologyOptions& options,
+                                     const std::vector<PlaceName>& names, TopologyReport* report);
+
+}  // namespace lampnav::mapping

@@ -1,0 +1,347 @@
+#include "lampnav/mapping/topology.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+
+#include "lampnav/core/error.hpp"
+
+namespace lampnav::mapping {
+
+using Eigen::Vector2d;
+
+void TopologyOptions::validate() const {
+  auto check = [](bool ok, const char* field, const char* what) {
+    if (!ok) throw InputError({"topology options", "", field}, what);
+  };
+  check(corridor_width_m > 0.3 && corridor_width_m < 20, "corridor_width_m", "must be 0.3 to 20 m");
+  check(simplify_m > 0, "simplify_m", "must be positive");
+  check(min_stretch_m > 0, "min_stretch_m", "must be positive");
+  check(same_line_m > 0, "same_line_m", "must be positive");
+  check(parallel_deg > 0 && parallel_deg < 45, "parallel_deg", "must be 0 to 45 degrees");
+  check(gap_m >= 0, "gap_m", "must not be negative");
+  check(place_m > 0, "place_m", "must be positive");
+}
+
+namespace {
+
+// A straight line the drive went along, and the stretches of it driven (as intervals of the
+// distance along it), merged into runs.
+struct Line {
+  Vector2d origin, dir;  // dir canonical: angle in (-pi/2, pi/2]
+  std::vector<std::pair<double, double>> intervals;
+  Vector2d at(double s) const { return origin + s * dir; }
+  double along(const Vector2d& p) const { return (p - origin).dot(dir); }
+  double across(const Vector2d& p) const {
+    const Vector2d d = p - origin;
+    return std::abs(d.x() * dir.y() - d.y() * dir.x());
+  }
+};
+
+struct Run {
+  int line = 0;
+  double s0 = 0, s1 = 0;
+};
+
+struct Place {
+  Vector2d point = Vector2d::Zero();
+  int members = 0;
+  std::vector<Vector2d> ways;
+  graph::Place kind = graph::Place::junction;
+  int node = -1;
+};
+
+// Douglas-Peucker: indices of the points kept.
+void simplify(const std::vector<Vector2d>& p, std::size_t a, std::size_t b, double tol,
+              std::vector<std::size_t>& keep) {
+  if (b <= a + 1) return;
+  const Vector2d d = p[b] - p[a];
+  const double len = d.norm();
+  double worst = -1;
+  std::size_t at = a;
+  for (std::size_t i = a + 1; i < b; ++i) {
+    const Vector2d e = p[i] - p[a];
+    const double dist = len > 1e-9 ? std::abs(d.x() * e.y() - d.y() * e.x()) / len : e.norm();
+    if (dist > worst) {
+      worst = dist;
+      at = i;
+    }
+  }
+  if (worst > tol) {
+    simplify(p, a, at, tol, keep);
+    keep.push_back(at);
+    simplify(p, at, b, tol, keep);
+  }
+}
+
+Vector2d canonical(Vector2d d) {
+  d.normalize();
+  if (d.x() < -1e-9 || (std::abs(d.x()) <= 1e-9 && d.y() < 0)) d = -d;
+  return d;
+}
+
+graph::Polygon rectangle(const Vector2d& a, const Vector2d& b, double width) {
+  const Vector2d d = (b - a).normalized();
+  const Vector2d n(-d.y() * width / 2, d.x() * width / 2);
+  return graph::Polygon({a - n, b - n, b + n, a + n});
+}
+
+}  // namespace
+
+graph::TopologicalMap build_topology(const MappingResult& mapped, const TopologyOptions& o,
+                                     const std::vector<PlaceName>& names, TopologyReport* report) {
+  o.validate();
+  TopologyReport rep;
+  const double w = o.corridor_width_m;
+  const double near = std::max(o.place_m, w);
+  std::vector<Vector2d> pts;
+  for (const auto& k : mapped.keyframes) pts.push_back(k.pose.translation());
+  graph::TopologicalMap map("built");
+  if (pts.size() < 2) {
+    rep.notes.push_back("the drive has fewer than two keyframes: no places");
+    if (report) *report = rep;
+    return map;
+  }
+
+  // 1. Straight stretches of the drive, grouped into lines.
+  std::vector<std::size_t> keep = {0};
+  simplify(pts, 0, pts.size() - 1, o.simplify_m, keep);
+  keep.push_back(pts.size() - 1);
+  std::sort(keep.begin(), keep.end());
+  std::vector<Line> lines;
+  const double parallel = std::sin(o.parallel_deg * M_PI / 180);
+  for (std::size_t i = 1; i < keep.size(); ++i) {
+    const Vector2d a = pts[keep[i - 1]], b = pts[keep[i]];
+    if ((b - a).norm() < o.min_stretch_m) continue;
+    const Vector2d d = canonical(b - a);
+    int found = -1;
+    for (std::size_t l = 0; l < lines.size(); ++l) {
+      const Vector2d& ld = lines[l].dir;
+      if (std::abs(ld.x() * d.y() - ld.y() * d.x()) > parallel) continue;
+      if (lines[l].across(a) < o.same_line_m && lines[l].across(b) < o.same_line_m) {
+        found = static_cast<int>(l);
+        break;
+      }
+    }
+    if (found < 0) {
+      lines.push_back({a, d, {}});
+      found = static_cast<int>(lines.size()) - 1;
+    }
+    Line& L = lines[found];
+    const double sa = L.along(a), sb = L.along(b);
+    L.intervals.emplace_back(std::min(sa, sb), std::max(sa, sb));
+  }
+  std::vector<Run> runs;
+  for (std::size_t l = 0; l < lines.size(); ++l) {
+    auto iv = lines[l].intervals;
+    std::sort(iv.begin(), iv.end());
+    for (const auto& [s0, s1] : iv) {
+      if (!runs.empty() && runs.back().line == static_cast<int>(l) &&
+          s0 <= runs.back().s1 + o.gap_m) {
+        runs.back().s1 = std::max(runs.back().s1, s1);
+      } else {
+        runs.push_back({static_cast<int>(l), s0, s1});
+      }
+    }
+  }
+
+  // 2. Places: where runs of two lines meet, and where a run ends with nothing there.
+  std::vector<Place> places;
+  auto add_place = [&](const Vector2d& p) {
+    for (auto& q : places) {
+      if ((q.point - p).norm() < near) {
+        q.point = (q.point * q.members + p) / (q.members + 1);
+        ++q.members;
+        return;
+      }
+    }
+    places.push_back({p, 1, {}, graph::Place::junction, -1});
+  };
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    for (std::size_t j = i + 1; j < runs.size(); ++j) {
+      const Line &A = lines[runs[i].line], &B = lines[runs[j].line];
+      const double cross = A.dir.x() * B.dir.y() - A.dir.y() * B.dir.x();
+      if (std::abs(cross) <= parallel) continue;
+      const Vector2d d = B.origin - A.origin;
+      const double s = (d.x() * B.dir.y() - d.y() * B.dir.x()) / cross;
+      const Vector2d p = A.at(s);
+      const double t = B.along(p);
+      if (s < runs[i].s0 - o.place_m || s > runs[i].s1 + o.place_m) continue;
+      if (t < runs[j].s0 - o.place_m || t > runs[j].s1 + o.place_m) continue;
+      add_place(p);
+    }
+  }
+  for (const auto& r : runs) {
+    add_place(lines[r.line].at(r.s0));
+    add_place(lines[r.line].at(r.s1));
+  }
+  // Ways out of each place: the runs that go on from it by more than a place's size.
+  auto runs_through = [&](const Place& q) {
+    std::vector<std::pair<const Run*, double>> out;
+    for (const auto& r : runs) {
+      const Line& L = lines[r.line];
+      const double s = L.along(q.point);
+      if (L.across(q.point) < o.same_line_m + 0.5 && s >= r.s0 - near && s <= r.s1 + near)
+        out.emplace_back(&r, s);
+    }
+    return out;
+  };
+  std::vector<Place> kept;
+  for (auto& q : places) {
+    for (const auto& [r, s] : runs_through(q)) {
+      const Vector2d d = lines[r->line].dir;
+      for (const Vector2d& way : {Vector2d(d), Vector2d(-d)}) {
+        const bool goes_on = way.dot(d) > 0 ? r->s1 - s > near : s - r->s0 > near;
+        if (!goes_on) continue;
+        bool known = false;
+        for (const auto& v : q.ways) known = known || v.dot(way) > std::cos(20 * M_PI / 180);
+        if (!known) q.ways.push_back(way);
+      }
+    }
+    const std::size_t n = q.ways.size();
+    if (n == 2 && q.ways[0].dot(q.ways[1]) < -std::cos(20 * M_PI / 180)) continue;  // straight on
+    q.kind = n <= 1 ? graph::Place::end : n == 2 ? graph::Place::corner : graph::Place::junction;
+    kept.push_back(q);
+  }
+  places = std::move(kept);
+
+  // When the drive first came near a point: places and corridors are numbered in that order.
+  auto first_reached = [&](const Vector2d& p) {
+    for (std::size_t k = 0; k < pts.size(); ++k)
+      if ((pts[k] - p).norm() < near) return k;
+    return pts.size();
+  };
+
+  // 3. Corridors: the pieces of each run between consecutive places on it.
+  struct Corridor {
+    Vector2d a, b;  // axis
+    int from, to;   // places
+  };
+  std::vector<Corridor> corridors;
+  for (const auto& r : runs) {
+    const Line& L = lines[r.line];
+    std::vector<std::pair<double, int>> on;
+    for (std::size_t i = 0; i < places.size(); ++i) {
+      const double s = L.along(places[i].point);
+      if (L.across(places[i].point) < o.same_line_m + 0.5 && s >= r.s0 - near && s <= r.s1 + near)
+        on.emplace_back(s, static_cast<int>(i));
+    }
+    std::sort(on.begin(), on.end());
+    for (std::size_t k = 1; k < on.size(); ++k) {
+      const double len = on[k].first - on[k - 1].first;
+      if (len < w + 0.5) continue;
+      // Along the line itself, from one place's square to the next one's.
+      corridors.push_back({L.at(on[k - 1].first + w / 2), L.at(on[k].first - w / 2),
+                           on[k - 1].second, on[k].second});
+    }
+  }
+
+  // 4. Nodes, in the order the drive reached them, with names and regions.
+  struct Pending {
+    std::size_t reached;
+    bool corridor;
+    int index;
+  };
+  std::vector<Pending> order;
+  for (std::size_t i = 0; i < places.size(); ++i)
+    order.push_back({first_reached(places[i].point), false, static_cast<int>(i)});
+  for (std::size_t i = 0; i < corridors.size(); ++i)
+    order.push_back(
+        {first_reached(0.5 * (corridors[i].a + corridors[i].b)), true, static_cast<int>(i)});
+  std::stable_sort(order.begin(), order.end(),
+                   [](const Pending& x, const Pending& y) { return x.reached < y.reached; });
+  std::map<char, int> counters;
+  std::vector<graph::Node> nodes;
+  std::vector<int> corridor_node(corridors.size(), -1);
+  for (const auto& p : order) {
+    graph::Node n;
+    n.id = NodeId(static_cast<std::int64_t>(nodes.size()) + 1);
+    char letter;
+    if (p.corridor) {
+      const Corridor& c = corridors[p.index];
+      n.place = graph::Place::corridor;
+      n.axis = graph::Axis{c.a, c.b};
+      n.width = w;
+      n.point = 0.5 * (c.a + c.b);
+      n.region = rectangle(c.a, c.b, w);
+      letter = 'C';
+      corridor_node[p.index] = static_cast<int>(nodes.size());
+    } else {
+      Place& q = places[p.index];
+      n.place = q.kind;
+      n.point = q.point;
+      // A square across the corridors that meet here (a hair smaller, so that estimates a
+      // tenth of a degree apart do not make neighbours overlap).
+      const Vector2d d = q.ways.empty() ? Vector2d(1, 0) : q.ways.front();
+      const double side = w - 0.02;
+      n.region = rectangle(q.point - d * side / 2, q.point + d * side / 2, side);
+      letter = q.kind == graph::Place::end ? 'E' : q.kind == graph::Place::corner ? 'K' : 'J';
+      q.node = static_cast<int>(nodes.size());
+    }
+    n.name = std::string(1, letter) + std::to_string(++counters[letter]);
+    for (const auto& nm : names)
+      if (n.region.contains(nm.at)) n.name = nm.name;
+    nodes.push_back(std::move(n));
+  }
+
+  // 5. Lamps into the place whose region holds them, in walking order.
+  std::vector<std::vector<const MappedLamp*>> held(nodes.size());
+  for (const auto& l : mapped.lamps) {
+    int at = -1;
+    for (std::size_t i = 0; i < nodes.size() && at < 0; ++i)
+      if (nodes[i].region.contains(l.xyz.head<2>(), 1e-6)) at = static_cast<int>(i);
+    if (at < 0) {
+      ++rep.lamps_outside;
+      continue;
+    }
+    held[at].push_back(&l);
+    ++rep.lamps_placed;
+  }
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    graph::Node& n = nodes[i];
+    auto& ls = held[i];
+    if (n.axis) {
+      std::sort(ls.begin(), ls.end(), [&](const MappedLamp* x, const MappedLamp* y) {
+        return n.axis->along(x->xyz.head<2>()) < n.axis->along(y->xyz.head<2>());
+      });
+    }
+    for (const MappedLamp* l : ls) {
+      graph::Lamp lamp;
+      lamp.id = LampId(n.name + "-L" + std::to_string(n.lamps.size() + 1));
+      lamp.xyz = l->xyz;
+      lamp.shape = l->shape;
+      lamp.length = l->length;
+      lamp.width = l->width;
+      lamp.yaw = l->yaw;
+      lamp.yaw_given = l->shape == graph::LampShape::rectangle;
+      n.lamps.push_back(lamp);
+    }
+  }
+  for (auto& n : nodes) map.add_node(n);
+
+  // 6. Edges: each corridor to the places at its ends, both ways.
+  std::int64_t next_edge = 1000;
+  for (std::size_t i = 0; i < corridors.size(); ++i) {
+    const graph::Node& c = nodes[corridor_node[i]];
+    for (const int pl : {corridors[i].from, corridors[i].to}) {
+      const graph::Node& q = nodes[places[pl].node];
+      for (const auto& [s, e] : {std::pair{&c, &q}, std::pair{&q, &c}}) {
+        graph::Edge edge;
+        edge.id = EdgeId(next_edge++);
+        edge.start = s->id;
+        edge.end = e->id;
+        edge.geometry = {{s->point, e->point}};
+        edge.cost = (e->point - s->point).norm();
+        map.add_edge(edge);
+      }
+    }
+  }
+  if (rep.lamps_outside)
+    rep.notes.push_back(std::to_string(rep.lamps_outside) +
+                        " lamps lie in no corridor or place the drive went through (rooms, "
+                        "halls): left out");
+  if (report) *report = rep;
+  return map;
+}
+
+}  // namespace lampnav::mapping

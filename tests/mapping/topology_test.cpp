@@ -1,0 +1,89 @@
+// Places and connections from a mapped drive: on the office floor, driven down every corridor,
+// the built map has the true map's corridors, junctions, corners and ends, connected the same way,
+// each lamp in the right place's sequence (up to names, and leaving out the rooms and doors the
+// drive never entered).
+
+#include "lampnav/mapping/topology.hpp"
+
+#include <gtest/gtest.h>
+
+#include <iostream>
+#include <set>
+
+#include "drive.hpp"
+#include "lampnav/graph/geojson.hpp"
+#include "lampnav/graph/map_checks.hpp"
+#include "lampnav_test.hpp"
+
+namespace lampnav::mapping {
+namespace {
+
+using Eigen::Vector2d;
+
+TEST(Topology, OfficeDrivenDownEveryCorridorHasTheTrueTopology) {
+  const graph::TopologicalMap truth =
+      graph::read_map(test::source_path("maps/office_floor.geojson")).map;
+  const RobotDescription robot =
+      read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  const sim::LampSensors sensors(truth, robot);
+  const std::vector<Vector2d> route = {{1, 10},  {21, 10}, {41, 10}, {41, -8},
+                                       {21, -8}, {1, -8},  {21, -8}, {21, 10}};
+  const test::DriveRecord drive = test::drive_through(route, 0.0, sensors, robot.semi_axis);
+  LampMapper mapper(robot);
+  std::size_t w = 0;
+  for (const auto& f : drive.frames) {
+    for (; w < drive.wheels.size() && drive.wheels[w].stamp <= f.stamp; ++w)
+      mapper.wheels(drive.wheels[w].stamp, drive.wheels[w].left, drive.wheels[w].right);
+    mapper.ceiling(f.stamp, f.lamps);
+  }
+  const MappingResult mapped = mapper.finish();
+  TopologyReport rep;
+  const graph::TopologicalMap built = build_topology(mapped, {}, {}, &rep);
+  // It is a valid map: written and read back by the map reader's rules.
+  const graph::LoadedMap reread = graph::parse_map(graph::write_map(built), "built");
+  EXPECT_TRUE(reread.warnings.empty()) << reread.warnings.front().text();
+  EXPECT_EQ(rep.lamps_outside, 0u);
+
+  // Each built node, moved into the true map's frame, lies in a true node of the same kind.
+  std::map<std::int64_t, const graph::Node*> match;
+  std::map<graph::Place, int> kinds_built, kinds_true;
+  for (const auto& n : built.nodes()) {
+    ++kinds_built[n.place];
+    const graph::Node* t = truth.node_containing(drive.start.transform_from(n.point));
+    ASSERT_NE(t, nullptr) << n.name;
+    EXPECT_EQ(t->place, n.place) << n.name << " is " << t->name;
+    match[n.id.value] = t;
+    // Its lamps, in order, are the true node's (a corridor may be walked the other way).
+    std::vector<std::string> ids, rev;
+    for (const auto& l : n.lamps) {
+      const auto near = truth.lamps_within(drive.start.transform_from(l.xyz.head<2>()), 0.3);
+      ASSERT_FALSE(near.empty()) << l.id.value;
+      ids.push_back(near.front()->id.value);
+    }
+    std::vector<std::string> want;
+    for (const auto& l : t->lamps) want.push_back(l.id.value);
+    rev.assign(want.rbegin(), want.rend());
+    EXPECT_TRUE(ids == want || ids == rev) << n.name << " (" << t->name << ")";
+  }
+  for (const auto& n : truth.nodes())
+    if (n.place != graph::Place::door && n.place != graph::Place::room) ++kinds_true[n.place];
+  EXPECT_EQ(kinds_built, kinds_true);
+  // Connected the same way.
+  std::set<std::pair<std::int64_t, std::int64_t>> built_links, true_links;
+  for (const auto& e : built.edges())
+    built_links.insert({match.at(e.start.value)->id.value, match.at(e.end.value)->id.value});
+  for (const auto& e : truth.edges()) {
+    const auto& a = truth.node(e.start);
+    const auto& b = truth.node(e.end);
+    if (a.place == graph::Place::door || b.place == graph::Place::door ||
+        a.place == graph::Place::room || b.place == graph::Place::room)
+      continue;
+    true_links.insert({a.id.value, b.id.value});
+  }
+  EXPECT_EQ(built_links, true_links);
+  std::cout << built.node_count() << " places, " << built.edge_count() << " edges, "
+            << built.lamp_count() << " lamps\n";
+}
+
+}  // namespace
+}  // namespace lampnav::mapping
