@@ -77,6 +77,7 @@ void add_map_commands(CLI::App& app, Job& run) {
       app.add_subcommand("map", "Validate, draw or build a map (shared/spec/map-format.md)");
   map->require_subcommand(1);
   add_map_build_command(*map, run);
+  add_map_survey_command(*map, run);
 
   auto check_args = std::make_shared<CheckArgs>();
   CLI::App* check = map->add_subcommand("check", "Validate a map; print a summary or the errors");

@@ -1,4 +1,5 @@
 // lampnav map build LOG.mcap [--robot R.json] -o M.geojson [--names NAMES.json]
+// lampnav map survey M LOG.mcap [--robot R.json] [--json] [--update OUT.geojson]
 
 #include <CLI/CLI.hpp>
 #include <chrono>
@@ -7,11 +8,14 @@
 #include <map>
 #include <memory>
 
+#include <iomanip>
+#include <nlohmann/json.hpp>
 #include "commands.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/internal/json_util.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/mapping/map_builder.hpp"
+#include "lampnav/mapping/survey.hpp"
 
 namespace lampnav::apps {
 
@@ -40,20 +44,22 @@ std::vector<mapping::PlaceName> read_names(const std::string& path) {
   return names;
 }
 
+// --robot, else the log's robot.json attachment.
+RobotDescription robot_for(const io::MissionLog& log, const std::string& log_path,
+                           const std::string& robot_path) {
+  if (!robot_path.empty()) return read_robot_description(robot_path);
+  if (log.robot_json)
+    return parse_robot_description(*log.robot_json, log_path + " (robot.json attachment)");
+  throw InputError({log_path, "attachments", "robot.json"},
+                   "the log has no robot.json: give --robot");
+}
+
 int run_build(const BuildArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::vector<mapping::PlaceName> names =
       a.names.empty() ? std::vector<mapping::PlaceName>{} : read_names(a.names);
   const io::MissionLog log = io::read_mission_log(a.log);
-  RobotDescription robot;
-  if (!a.robot.empty()) {
-    robot = read_robot_description(a.robot);
-  } else if (log.robot_json) {
-    robot = parse_robot_description(*log.robot_json, a.log + " (robot.json attachment)");
-  } else {
-    throw InputError({a.log, "attachments", "robot.json"},
-                     "the log has no robot.json: give --robot");
-  }
+  const RobotDescription robot = robot_for(log, a.log, a.robot);
   mapping::MapBuildOptions o;
   o.topology.corridor_width_m = a.corridor_width;
   ProgressBar bar(a.quiet);
@@ -87,7 +93,100 @@ int run_build(const BuildArgs& a) {
   return 0;
 }
 
+struct SurveyArgs {
+  std::string map, log, robot, update, initial_pose;
+  bool json = false, quiet = false;
+};
+
+int run_survey(const SurveyArgs& a) {
+  const graph::LoadedMap loaded = graph::read_map(a.map);
+  for (const auto& w : loaded.warnings) diagnostic("warning", w.text());
+  const io::MissionLog log = io::read_mission_log(a.log);
+  const RobotDescription robot = robot_for(log, a.log, a.robot);
+  ProgressBar bar(a.quiet || a.json);
+  const mapping::DriveLamps drive = mapping::map_drive_lamps(
+      log, a.log, robot, {}, [&bar](double f) { bar.update(f, "mapping the drive"); });
+  bar.done();
+  for (const auto& note : drive.notes) diagnostic("note", note);
+  mapping::SurveyOptions so;
+  if (!a.initial_pose.empty()) so.start = parse_pose_option(a.initial_pose, "--initial-pose");
+  const mapping::SurveyResult s = mapping::survey(loaded.map, drive.mapped, robot, so);
+  if (!a.update.empty()) graph::save_map(s.updated, a.update);
+  int failed = 0, moved = 0, added = 0;
+  for (const auto& f : s.findings) {
+    failed += f.status == mapping::LampStatus::failed;
+    moved += f.status == mapping::LampStatus::moved;
+    added += f.status == mapping::LampStatus::added;
+  }
+  auto xyz = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
+  if (a.json) {
+    nlohmann::json j = {{"map", a.map},
+                        {"log", a.log},
+                        {"judged", s.judged},
+                        {"ok", s.ok},
+                        {"failed", failed},
+                        {"moved", moved},
+                        {"new", added},
+                        {"alignment", {{"lamps", s.agreeing}, {"rms_m", s.alignment_rms_m}}},
+                        {"lamps", nlohmann::json::array()}};
+    for (const auto& f : s.findings) {
+      nlohmann::json e = {{"status", mapping::to_string(f.status)},
+                          {"id", f.lamp},
+                          {"place", f.node},
+                          {"where", f.where}};
+      if (f.status != mapping::LampStatus::added) e["map_xyz"] = xyz(f.map_xyz);
+      if (f.status != mapping::LampStatus::failed) e["seen_xyz"] = xyz(f.seen_xyz);
+      if (f.status == mapping::LampStatus::moved) e["moved_m"] = f.offset_m;
+      j["lamps"].push_back(e);
+    }
+    if (!a.update.empty()) j["updated_map"] = a.update;
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << "survey of " << a.map << " with " << a.log << ": " << s.judged
+            << " lamps in clear view, " << s.ok << " where the map has them; " << failed
+            << " failed, " << moved << " moved, " << added << " new\n";
+  if (!s.findings.empty()) {
+    std::cout << std::left << std::setw(8) << "status" << std::setw(12) << "lamp" << std::setw(34)
+              << "where"
+              << "detail\n";
+    for (const auto& f : s.findings) {
+      char detail[96] = "";
+      if (f.status == mapping::LampStatus::moved)
+        std::snprintf(detail, sizeof detail, "moved %.1f cm, now at (%.2f, %.2f)", f.offset_m * 100,
+                      f.seen_xyz.x(), f.seen_xyz.y());
+      else if (f.status == mapping::LampStatus::added)
+        std::snprintf(detail, sizeof detail, "at (%.2f, %.2f, %.2f)", f.seen_xyz.x(),
+                      f.seen_xyz.y(), f.seen_xyz.z());
+      else
+        std::snprintf(detail, sizeof detail, "in view, never lit");
+      std::cout << std::setw(8) << mapping::to_string(f.status) << std::setw(12) << f.lamp
+                << std::setw(34) << f.where << detail << "\n";
+    }
+  }
+  if (!a.update.empty()) std::cout << "corrected map: " << a.update << "\n";
+  return 0;
+}
+
 }  // namespace
+
+void add_map_survey_command(CLI::App& map, Job& run) {
+  auto args = std::make_shared<SurveyArgs>();
+  CLI::App* survey = map.add_subcommand(
+      "survey", "Compare a drive with a map: failed, moved and new lamps, named by place");
+  survey->add_option("MAP", args->map, "Map file (.geojson)")->required();
+  survey->add_option("LOG", args->log, "Mission log of the drive (.mcap)")->required();
+  survey->add_option("--robot", args->robot, "robot.json (default: the log's attachment)");
+  survey->add_flag("--json", args->json, "Print the findings as JSON");
+  survey->add_option("--initial-pose", args->initial_pose,
+                     "X,Y,YAW: where the drive started in the map (m, m, rad), when the drive "
+                     "alone fits several places");
+  survey->add_option("--update", args->update,
+                     "Write the corrected map (moved lamps moved, new ones added, failed ones "
+                     "taken out)");
+  survey->add_flag("--quiet", args->quiet, "No progress bar");
+  survey->callback([args, &run] { run = [args] { return run_survey(*args); }; });
+}
 
 void add_map_build_command(CLI::App& map, Job& run) {
   auto args = std::make_shared<BuildArgs>();

@@ -181,30 +181,9 @@ struct ReplayArgs {
   bool no_ceiling = false, no_omni = false, quiet = false;
 };
 
-Pose2 parse_pose(const std::string& text) {
-  std::vector<double> v;
-  std::stringstream s(text);
-  std::string part;
-  while (std::getline(s, part, ',')) {
-    try {
-      std::size_t used = 0;
-      v.push_back(std::stod(part, &used));
-      if (used != part.size() || !std::isfinite(v.back())) throw std::invalid_argument(part);
-    } catch (const std::exception&) {
-      throw InputError(
-          {"", "--initial-pose", ""},
-          "'" + part + "' is not a number (expected X,Y,YAW: metres, metres, radians)");
-    }
-  }
-  if (v.size() != 3)
-    throw InputError({"", "--initial-pose", ""},
-                     "expected X,Y,YAW (metres, metres, radians), found '" + text + "'");
-  return Pose2(v[0], v[1], wrap_angle(v[2]));
-}
-
 int run_replay(const ReplayArgs& a) {
   std::optional<Pose2> initial;
-  if (!a.initial_pose.empty()) initial = parse_pose(a.initial_pose);
+  if (!a.initial_pose.empty()) initial = parse_pose_option(a.initial_pose, "--initial-pose");
   if (!fs::exists(a.log)) throw InputError({a.log, "", ""}, "no such file");
   const io::MissionLog log = io::read_mission_log(a.log);
   std::string map_text, map_source;

@@ -7,6 +7,8 @@
 #include <iosfwd>
 #include <string>
 
+#include "lampnav/core/pose2.hpp"
+
 namespace CLI {
 class App;
 }
@@ -16,7 +18,8 @@ namespace lampnav::apps {
 using Job = std::function<int()>;
 
 void add_map_commands(CLI::App& app, Job& run);
-void add_map_build_command(CLI::App& map, Job& run);  // map build (under `map`)
+void add_map_build_command(CLI::App& map, Job& run);   // map build (under `map`)
+void add_map_survey_command(CLI::App& map, Job& run);  // map survey (under `map`)
 void add_route_command(CLI::App& app, Job& run);
 void add_sim_command(CLI::App& app, Job& run);
 void add_locate_command(CLI::App& app, Job& run);
@@ -36,6 +39,9 @@ class ProgressBar {
   bool show_;
   int last_ = -1;
 };
+
+// X,Y,YAW (m, m, rad) from a command-line option; InputError naming `flag` otherwise.
+Pose2 parse_pose_option(const std::string& text, const std::string& flag);
 
 // Prints a diagnostic line to stderr: "lampnav: <kind>: <text>".
 void diagnostic(const std::string& kind, const std::string& text);

@@ -5,8 +5,11 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <iostream>
+#include <sstream>
+#include <vector>
 
 #include "commands.hpp"
 #include "lampnav/core/error.hpp"
@@ -19,6 +22,27 @@ void diagnostic(const std::string& kind, const std::string& text) {
 std::string data_path(const std::string& relative) {
   const char* env = std::getenv("LAMPNAV_DATA_DIR");
   return std::string(env && *env ? env : LAMPNAV_DATA_DIR) + "/" + relative;
+}
+
+Pose2 parse_pose_option(const std::string& text, const std::string& flag) {
+  std::vector<double> v;
+  std::stringstream s(text);
+  std::string part;
+  while (std::getline(s, part, ',')) {
+    try {
+      std::size_t used = 0;
+      v.push_back(std::stod(part, &used));
+      if (used != part.size() || !std::isfinite(v.back())) throw std::invalid_argument(part);
+    } catch (const std::exception&) {
+      throw InputError({"", flag, ""}, "'" + part +
+                                           "' is not a number (expected X,Y,YAW: metres, "
+                                           "metres, radians)");
+    }
+  }
+  if (v.size() != 3)
+    throw InputError({"", flag, ""},
+                     "expected X,Y,YAW (metres, metres, radians), found '" + text + "'");
+  return Pose2(v[0], v[1], wrap_angle(v[2]));
 }
 
 ProgressBar::ProgressBar(bool quiet) : show_(!quiet && ::isatty(2)) {}

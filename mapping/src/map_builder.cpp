@@ -38,10 +38,9 @@ vision::LampShapePrior probe_prior() {
 
 }  // namespace
 
-MapBuildResult build_map(const io::MissionLog& log, const std::string& source,
-                         const RobotDescription& robot, const MapBuildOptions& o,
-                         const std::vector<PlaceName>& names,
-                         const std::function<void(double)>& progress) {
+DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
+                           const RobotDescription& robot, const MapBuildOptions& o,
+                           const std::function<void(double)>& progress) {
   o.validate();
   const CameraDescription* cam = robot.find_camera("ceiling_camera");
   if (!cam)
@@ -60,7 +59,7 @@ MapBuildResult build_map(const io::MissionLog& log, const std::string& source,
   std::sort(frames.begin(), frames.end(),
             [](const auto* a, const auto* b) { return a->value.stamp < b->value.stamp; });
 
-  MapBuildResult out;
+  DriveLamps out;
   // 1. The lamps' look: full blobs from frames spread over the drive, at unit distance.
   {
     vision::LampDetectorOptions probe_options = o.detector;
@@ -133,6 +132,18 @@ MapBuildResult build_map(const io::MissionLog& log, const std::string& source,
                     std::to_string(out.lamps_seen_whole) + " sightings in " +
                     std::to_string(out.frames) + " frames)");
 
+  if (out.unreadable_frames)
+    out.notes.push_back(std::to_string(out.unreadable_frames) +
+                        " ceiling frames could not be decoded and were skipped");
+  return out;
+}
+
+MapBuildResult build_map(const io::MissionLog& log, const std::string& source,
+                         const RobotDescription& robot, const MapBuildOptions& o,
+                         const std::vector<PlaceName>& names,
+                         const std::function<void(double)>& progress) {
+  MapBuildResult out;
+  static_cast<DriveLamps&>(out) = map_drive_lamps(log, source, robot, o, progress);
   // 3. Places and connections.
   out.map = build_topology(out.mapped, o.topology, names, &out.topology);
   if (out.map.edge_count() == 0)

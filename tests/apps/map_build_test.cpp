@@ -2,13 +2,14 @@
 // detector) becomes a valid map whose lamps are where the true ones are, without the log's map.
 
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "alignment.hpp"
 #include "cli_support.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
+#include "lampnav/mapping/rigid_fit.hpp"
 #include "lampnav_test.hpp"
 
 namespace lampnav {
@@ -63,10 +64,10 @@ TEST(MapBuild, ADriveBecomesAValidMapWithTheLampsWhereTheyAre) {
     }
   }
   // After the best rigid alignment (the map's frame is the drive's start).
-  const test::RigidFit fit = test::fit_rigid(pairs);
+  const Pose2 fit = mapping::fit_rigid(pairs);
   double worst = 0, sum = 0;
   for (const auto& [b, t] : pairs) {
-    const double e = (fit.apply(b) - t).norm();
+    const double e = (fit.transform_from(b) - t).norm();
     worst = std::max(worst, e);
     sum += e * e;
   }
@@ -81,6 +82,54 @@ TEST(MapBuild, ADriveBecomesAValidMapWithTheLampsWhereTheyAre) {
   // The targets, met on one pass with no loop to close.
   EXPECT_LE(rms, 0.02);
   EXPECT_LE(worst, 0.05);
+
+  // The same drive surveyed against the true map: the office is symmetric under a half turn
+  // along this drive, so without the start the survey says so; with it, every lamp is there.
+  const std::string office = test::quoted_source("maps/office_floor.geojson");
+  const auto twins = test::run_lampnav("map survey " + office + " '" + rec.log + "' --quiet");
+  EXPECT_EQ(twins.status, 1) << twins.out;
+  EXPECT_THAT(twins.err, HasSubstr("several places"));
+  const auto same = test::run_lampnav("map survey " + office + " '" + rec.log +
+                                      "' --quiet --initial-pose 1,10,0");
+  ASSERT_EQ(same.status, 0) << same.err;
+  EXPECT_THAT(same.out, HasSubstr("0 failed, 0 moved, 0 new"));
+  // Against a map that lacks a lamp and has one too many: one new, one failed, named by place.
+  nlohmann::json doc =
+      nlohmann::json::parse(test::slurp(test::source_path("maps/office_floor.geojson")));
+  for (auto& f : doc["features"]) {
+    if (!f["properties"].contains("lampnav")) continue;
+    auto& lamps = f["properties"]["lampnav"]["lamps"];
+    for (std::size_t i = 0; i < lamps.size(); ++i) {
+      if (lamps[i]["id"] == "C1-L3") lamps.erase(i--);
+    }
+    if (f["properties"]["metadata"]["name"] == "C4") {
+      auto extra = lamps[1];
+      extra["id"] = "C4-GHOST";
+      extra["xyz"][0] = 0.5 * (lamps[1]["xyz"][0].get<double>() + lamps[2]["xyz"][0].get<double>());
+      lamps.insert(lamps.begin() + 2, extra);
+    }
+  }
+  const std::string edited = (rec.dir / "edited.geojson").string();
+  std::ofstream(edited) << doc.dump();
+  const auto js = test::run_lampnav("map survey '" + edited + "' '" + rec.log +
+                                    "' --quiet --json --initial-pose 1,10,0 --update '" +
+                                    (rec.dir / "fixed.geojson").string() + "'");
+  ASSERT_EQ(js.status, 0) << js.err;
+  const auto report = nlohmann::json::parse(js.out);
+  EXPECT_EQ(report["failed"], 1);
+  EXPECT_EQ(report["new"], 1);
+  EXPECT_EQ(report["moved"], 0);
+  for (const auto& l : report["lamps"]) {
+    if (l["status"] == "failed") {
+      EXPECT_EQ(l["id"], "C4-GHOST");
+    }
+    if (l["status"] == "new") {
+      EXPECT_EQ(l["place"], "C1");
+      EXPECT_THAT(l["where"].get<std::string>(), HasSubstr("C1, "));
+    }
+  }
+  EXPECT_EQ(test::run_lampnav("map check '" + (rec.dir / "fixed.geojson").string() + "'").status,
+            0);
 }
 
 TEST(MapBuild, RefusesWhatCannotMakeAMap) {

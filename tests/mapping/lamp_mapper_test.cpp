@@ -9,10 +9,10 @@
 #include <iostream>
 #include <set>
 
-#include "alignment.hpp"
 #include "drive.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/graph/planner.hpp"
+#include "lampnav/mapping/rigid_fit.hpp"
 #include "lampnav/sim/building.hpp"
 #include "lampnav_test.hpp"
 
@@ -60,10 +60,10 @@ Accuracy compare(const MappingResult& built, const graph::TopologicalMap& truth,
   }
   std::vector<std::pair<Vector2d, Vector2d>> point_pairs;
   for (const auto& [p, l] : pairs) point_pairs.emplace_back(p, l->xyz.head<2>());
-  const test::RigidFit fit = test::fit_rigid(point_pairs);
+  const Pose2 fit = mapping::fit_rigid(point_pairs);
   double sum = 0;
   for (std::size_t i = 0; i < pairs.size(); ++i) {
-    const Vector2d p = fit.apply(pairs[i].first);
+    const Vector2d p = fit.transform_from(pairs[i].first);
     const double e = (p - pairs[i].second->xyz.head<2>()).norm();
     sum += e * e;
     a.max_m = std::max(a.max_m, e);

@@ -28,15 +28,24 @@ struct MapBuildOptions {
   void validate() const;   // throws InputError naming the field
 };
 
-struct MapBuildResult {
-  graph::TopologicalMap map;
+// The lamps of a recorded drive (the first half of a map build; a survey's whole input).
+struct DriveLamps {
   MappingResult mapped;
-  TopologyReport topology;
   vision::LampShapePrior prior;  // learnt: the lamps' size seen from unit distance
   std::size_t frames = 0, unreadable_frames = 0, lamps_seen_whole = 0;
   double travel_m = 0;
-  std::vector<std::string> notes;  // what the map can and cannot contain, for the user
+  std::vector<std::string> notes;  // for the user
 };
+
+struct MapBuildResult : DriveLamps {
+  graph::TopologicalMap map;
+  TopologyReport topology;
+};
+
+// The lamp SLAM over a recorded drive. Throws as build_map does.
+DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
+                           const RobotDescription& robot, const MapBuildOptions& options,
+                           const std::function<void(double)>& progress = {});
 
 // `source` names the log in messages. Throws InputError when the log cannot give a map (no
 // ceiling camera frames, no wheels, a robot without a ceiling camera) and JobFailed when the

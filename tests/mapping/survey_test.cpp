@@ -1,0 +1,90 @@
+// A drive against the map after the building changed: 3 lamps failed, 2 moved 20 cm, 1 added.
+// The survey finds exactly those, says where each is, and writes the corrected map.
+
+#include "lampnav/mapping/survey.hpp"
+
+#include <gtest/gtest.h>
+
+#include <iostream>
+
+#include "drive.hpp"
+#include "lampnav/graph/geojson.hpp"
+#include "lampnav_test.hpp"
+
+namespace lampnav::mapping {
+namespace {
+
+using Eigen::Vector2d;
+
+// The office as it is now: two lamps moved, one added (the failed ones are the sensors').
+graph::TopologicalMap changed_office(const graph::TopologicalMap& map) {
+  graph::TopologicalMap world(map.name());
+  for (const graph::Node& n : map.nodes()) {
+    graph::Node c = n;
+    for (auto& l : c.lamps) {
+      if (l.id.value == "C5-L2") l.xyz.y() += 0.2;  // along the corridor
+      if (l.id.value == "C4-L3") l.xyz.y() += 0.2;  // across it
+    }
+    if (n.name == "C6") {
+      graph::Lamp added = c.lamps[1];
+      added.id = LampId("C6-NEW");
+      added.xyz.x() = 0.5 * (c.lamps[1].xyz.x() + c.lamps[2].xyz.x());
+      c.lamps.insert(c.lamps.begin() + 2, added);
+    }
+    world.add_node(c);
+  }
+  for (const auto& e : map.edges()) world.add_edge(e);
+  return world;
+}
+
+TEST(Survey, FindsTheFailedMovedAndNewLampsAndNothingElse) {
+  const graph::TopologicalMap map =
+      graph::read_map(test::source_path("maps/office_floor.geojson")).map;
+  const RobotDescription robot =
+      read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  const graph::TopologicalMap world = changed_office(map);
+  sim::LampSensorOptions so;
+  so.failed_lamps = {"C1-L3", "C2-L2", "C3-L4"};
+  const sim::LampSensors sensors(world, robot, so);
+  const std::vector<Vector2d> route = {{1, 10},  {21, 10}, {41, 10}, {41, -8},
+                                       {21, -8}, {1, -8},  {21, -8}, {21, 10}};
+  const test::DriveRecord drive = test::drive_through(route, 0.0, sensors, robot.semi_axis);
+  LampMapper mapper(robot);
+  std::size_t w = 0;
+  for (const auto& f : drive.frames) {
+    for (; w < drive.wheels.size() && drive.wheels[w].stamp <= f.stamp; ++w)
+      mapper.wheels(drive.wheels[w].stamp, drive.wheels[w].left, drive.wheels[w].right);
+    mapper.ceiling(f.stamp, f.lamps);
+  }
+  const SurveyResult s = survey(map, mapper.finish(), robot);
+  std::map<std::string, std::string> found;  // lamp -> status
+  for (const auto& f : s.findings) {
+    std::cout << to_string(f.status) << " " << f.lamp << " (" << f.where << ")"
+              << (f.status == LampStatus::moved ? " by " + std::to_string(f.offset_m) + " m" : "")
+              << "\n";
+    found[f.lamp] = to_string(f.status);
+  }
+  std::cout << s.judged << " judged, " << s.ok << " ok; aligned on " << s.agreeing << " lamps, rms "
+            << s.alignment_rms_m * 100 << " cm\n";
+  const std::map<std::string, std::string> want = {{"C1-L3", "failed"}, {"C2-L2", "failed"},
+                                                   {"C3-L4", "failed"}, {"C5-L2", "moved"},
+                                                   {"C4-L3", "moved"},  {"C6-N1", "new"}};
+  EXPECT_EQ(found, want);
+  for (const auto& f : s.findings) {
+    if (f.status == LampStatus::moved) {
+      EXPECT_NEAR(f.offset_m, 0.2, 0.03) << f.lamp;
+    }
+    EXPECT_FALSE(f.where.empty());
+  }
+  // The corrected map reads back, without the failed lamps, with the moved and new ones where
+  // they are now.
+  const graph::TopologicalMap up = graph::parse_map(graph::write_map(s.updated), "updated").map;
+  EXPECT_EQ(up.find_lamp(LampId("C1-L3")), nullptr);
+  ASSERT_NE(up.find_lamp(LampId("C6-N1")), nullptr);
+  EXPECT_NEAR(up.find_lamp(LampId("C6-N1"))->xyz.x(), 15.5, 0.05);
+  EXPECT_NEAR(up.find_lamp(LampId("C5-L2"))->xyz.y(), 5.7714, 0.05);
+  EXPECT_EQ(up.lamp_count(), map.lamp_count() - 3 + 1);
+}
+
+}  // namespace
+}  // namespace lampnav::mapping
