@@ -1,7 +1,9 @@
 #include "lampnav/mapping/map_builder.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <thread>
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/io/mission_log.hpp"
@@ -101,8 +103,28 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
     out.prior.max_distance = 1.4;
   }
 
-  // 2. Every frame through the detector and, with the wheels in time order, the lamp SLAM.
-  vision::LampDetector detector(*cam, out.prior, o.detector);
+  // 2. Every frame through the detector (decoding and detecting on every core, a detector each),
+  // then, with the wheels in time order, the lamp SLAM.
+  std::vector<std::vector<vision::LampDetection>> detected(frames.size());
+  std::vector<char> unreadable(frames.size(), 0);
+  const unsigned workers = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
+  std::atomic<std::size_t> next{0}, done{0};
+  auto work = [&] {
+    vision::LampDetector detector(*cam, out.prior, o.detector);
+    for (std::size_t i = next++; i < frames.size(); i = next++) {
+      try {
+        detected[i] = detector.detect(io::decode_image(frames[i]->value.data, source)).lamps;
+      } catch (const std::exception&) {
+        unreadable[i] = 1;
+      }
+      ++done;
+    }
+  };
+  std::vector<std::thread> pool;
+  for (unsigned k = 1; k < workers; ++k) pool.emplace_back(work);
+  work();
+  for (auto& t : pool) t.join();
+  if (progress) progress(0.9);
   LampMapper mapper(robot, o.mapper);
   std::size_t w = 0;
   const auto& wheels = log.wheels;
@@ -111,16 +133,12 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
     for (; w < wheels.size() && wheels[w].value.stamp <= t; ++w)
       mapper.wheels(wheels[w].value.stamp, wheels[w].value.left, wheels[w].value.right);
     ++out.frames;
-    std::vector<vision::LampDetection> lamps;
-    try {
-      lamps = detector.detect(io::decode_image(frames[i]->value.data, source)).lamps;
-    } catch (const std::exception&) {
+    if (unreadable[i]) {
       ++out.unreadable_frames;
       continue;
     }
-    for (const auto& d : lamps) out.lamps_seen_whole += d.view == vision::LampView::full;
-    mapper.ceiling(t, lamps);
-    if (progress && i % 50 == 0) progress(double(i) / frames.size());
+    for (const auto& d : detected[i]) out.lamps_seen_whole += d.view == vision::LampView::full;
+    mapper.ceiling(t, detected[i]);
   }
   out.mapped = mapper.finish();
   if (!out.mapped.keyframes.empty()) out.travel_m = out.mapped.keyframes.back().travel_m;

@@ -11,8 +11,11 @@
 #include <limits>
 #include <queue>
 
+#include "drive.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/graph/planner.hpp"
+#include "lampnav/mapping/lamp_mapper.hpp"
+#include "lampnav/mapping/topology.hpp"
 #include "lampnav/sim/building.hpp"
 #include "lampnav_test.hpp"
 #include "nav2_route/plugins/graph_file_loaders/geojson_graph_file_loader.hpp"
@@ -145,6 +148,28 @@ TEST(Nav2Loader, LoadsGeneratedBuildings) {
     expect_nav2_loads_alike(
         write_temp("generated_written_" + std::to_string(nodes), graph::write_map(lm.map)));
   }
+}
+
+// A map built from a drive down every corridor of the office (mapping/), as `map build` writes it.
+TEST(Nav2Loader, LoadsABuiltMap) {
+  const graph::TopologicalMap office =
+      graph::read_map(test::source_path("maps/office_floor.geojson")).map;
+  const RobotDescription robot =
+      read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  const sim::LampSensors sensors(office, robot);
+  const test::DriveRecord drive = test::drive_through(
+      {{1, 10}, {21, 10}, {41, 10}, {41, -8}, {21, -8}, {1, -8}, {21, -8}, {21, 10}}, 0.0, sensors,
+      robot.semi_axis);
+  mapping::LampMapper mapper(robot);
+  std::size_t w = 0;
+  for (const auto& f : drive.frames) {
+    for (; w < drive.wheels.size() && drive.wheels[w].stamp <= f.stamp; ++w)
+      mapper.wheels(drive.wheels[w].stamp, drive.wheels[w].left, drive.wheels[w].right);
+    mapper.ceiling(f.stamp, f.lamps);
+  }
+  const graph::TopologicalMap built = mapping::build_topology(mapper.finish(), {}, {}, nullptr);
+  ASSERT_GT(built.edge_count(), 0u);
+  expect_nav2_loads_alike(write_temp("built", graph::write_map(built)));
 }
 
 // Nav2's own graphs, read by lampnav and written back, still load in Nav2 the same.
