@@ -4,12 +4,14 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <thread>
 
 #include "lampnav/core/error.hpp"
 
@@ -420,9 +422,29 @@ MissionLog read_mission_log(const std::string& path) {
   log.report = f.report;
   if (const auto* a = f.attachment("robot.json")) log.robot_json = a->data;
   if (const auto* a = f.attachment("map.geojson")) log.map_geojson = a->data;
-  for (const McapMessage& m : f.messages) {
+  // Each message decoded on its own (JSON, base64: most of the time on image logs), on every
+  // core, then kept in the file's order.
+  struct Decoded {
+    enum Kind { none, wheels, ceiling, omni, truth, event, command, bad } kind = none;
+    Logged<WheelReading> wheel;
+    Logged<ImageFrame> image;
+    Logged<TruthPose> pose;
+    Logged<MissionEvent> event_value;
+    Logged<CommandMessage> command_value;
+    std::string problem;
+  };
+  std::vector<Decoded> decoded(f.messages.size());
+  auto decode = [&](std::size_t i) {
+    const McapMessage& m = f.messages[i];
     const McapChannel* ch = f.channel(m.channel_id);
     const Stamp avail = stamp_from_nanoseconds(static_cast<std::int64_t>(m.log_time));
+    Decoded& d = decoded[i];
+    const std::string& topic = ch->topic;
+    const bool input = topic == topics::kWheels || topic == topics::kCeilingImage ||
+                       topic == topics::kOmniImage || topic == topics::kTruth ||
+                       topic == topics::kEvents || topic == topics::kCommands;
+    // Other topics (a replay's own outputs, a user's extras) are not inputs: left alone.
+    if (!input) return;
     try {
       Json j;
       try {
@@ -431,30 +453,70 @@ MissionLog read_mission_log(const std::string& path) {
         throw BadMessage(std::string("bad JSON: ") + e.what());
       }
       if (!j.is_object()) throw BadMessage("not a JSON object");
-      const std::string& topic = ch->topic;
       if (topic == topics::kWheels) {
-        log.wheels.push_back({avail, {stamp(j), number(j, "left"), number(j, "right")}});
-      } else if (topic == topics::kCeilingImage) {
-        log.ceiling_images.push_back({avail, image(j)});
-      } else if (topic == topics::kOmniImage) {
-        log.omni_images.push_back({avail, image(j)});
+        d.wheel = {avail, {stamp(j), number(j, "left"), number(j, "right")}};
+        d.kind = Decoded::wheels;
+      } else if (topic == topics::kCeilingImage || topic == topics::kOmniImage) {
+        d.image = {avail, image(j)};
+        d.kind = topic == topics::kCeilingImage ? Decoded::ceiling : Decoded::omni;
       } else if (topic == topics::kTruth) {
         const Json& pose = member(j, "pose");
         const Json& p = member(pose, "position");
         const Json& q = member(pose, "orientation");
         const double yaw = 2.0 * std::atan2(number(q, "z"), number(q, "w"));
-        log.truth.push_back({avail, {stamp(j), Pose2(number(p, "x"), number(p, "y"), yaw)}});
+        d.pose = {avail, {stamp(j), Pose2(number(p, "x"), number(p, "y"), yaw)}};
+        d.kind = Decoded::truth;
       } else if (topic == topics::kEvents) {
-        log.events.push_back(
-            {avail, {stamp(j), text(j, "kind"), j.contains("detail") ? text(j, "detail") : ""}});
-      } else if (topic == topics::kCommands) {
-        log.commands.push_back({avail, {stamp(j), text(j, "text")}});
+        d.event_value = {
+            avail, {stamp(j), text(j, "kind"), j.contains("detail") ? text(j, "detail") : ""}};
+        d.kind = Decoded::event;
+      } else {
+        d.command_value = {avail, {stamp(j), text(j, "text")}};
+        d.kind = Decoded::command;
       }
-      // Other topics (a replay's own outputs, a user's extras) are not inputs: left alone.
     } catch (const BadMessage& e) {
-      ++log.skipped_messages;
-      log.problems.push_back(ch->topic + " message " + std::to_string(m.sequence) + ": " +
-                             e.what() + " (skipped)");
+      d.kind = Decoded::bad;
+      d.problem =
+          ch->topic + " message " + std::to_string(m.sequence) + ": " + e.what() + " (skipped)";
+    }
+  };
+  {
+    std::atomic<std::size_t> next{0};
+    auto work = [&] {
+      for (std::size_t i = next++; i < decoded.size(); i = next++) decode(i);
+    };
+    const unsigned n = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
+    std::vector<std::thread> pool;
+    for (unsigned k = 1; k < n && decoded.size() > 64; ++k) pool.emplace_back(work);
+    work();
+    for (auto& t : pool) t.join();
+  }
+  for (auto& d : decoded) {
+    switch (d.kind) {
+      case Decoded::wheels:
+        log.wheels.push_back(std::move(d.wheel));
+        break;
+      case Decoded::ceiling:
+        log.ceiling_images.push_back(std::move(d.image));
+        break;
+      case Decoded::omni:
+        log.omni_images.push_back(std::move(d.image));
+        break;
+      case Decoded::truth:
+        log.truth.push_back(std::move(d.pose));
+        break;
+      case Decoded::event:
+        log.events.push_back(std::move(d.event_value));
+        break;
+      case Decoded::command:
+        log.commands.push_back(std::move(d.command_value));
+        break;
+      case Decoded::bad:
+        ++log.skipped_messages;
+        log.problems.push_back(std::move(d.problem));
+        break;
+      case Decoded::none:
+        break;
     }
   }
   return log;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <thread>
 
@@ -62,6 +63,10 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
             [](const auto* a, const auto* b) { return a->value.stamp < b->value.stamp; });
 
   DriveLamps out;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto since = [](std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+  };
   // 1. The lamps' look: full blobs from frames spread over the drive, at unit distance.
   {
     vision::LampDetectorOptions probe_options = o.detector;
@@ -125,6 +130,8 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
   work();
   for (auto& t : pool) t.join();
   if (progress) progress(0.9);
+  out.detect_seconds = since(t0);
+  const auto t1 = std::chrono::steady_clock::now();
   LampMapper mapper(robot, o.mapper);
   std::size_t w = 0;
   const auto& wheels = log.wheels;
@@ -141,6 +148,16 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
     mapper.ceiling(t, detected[i]);
   }
   out.mapped = mapper.finish();
+  out.slam_seconds = since(t1);
+  if (o.start) {
+    // The whole drive and its lamps moved so that the start is where the user says.
+    const Pose2& T = *o.start;
+    for (auto& l : out.mapped.lamps) {
+      l.xyz.head<2>() = T.transform_from(l.xyz.head<2>());
+      l.yaw = wrap_angle(l.yaw + T.yaw());
+    }
+    for (auto& k : out.mapped.keyframes) k.pose = T * k.pose;
+  }
   if (!out.mapped.keyframes.empty()) out.travel_m = out.mapped.keyframes.back().travel_m;
   if (out.travel_m < 1.0)
     throw JobFailed(source + ": the robot moved " + std::to_string(out.travel_m) +

@@ -132,6 +132,57 @@ TEST(MapBuild, ADriveBecomesAValidMapWithTheLampsWhereTheyAre) {
             0);
 }
 
+// A map built from one drive along C1 and C2 (anchored at the drive's true start), then another
+// drive of the same corridors replayed on it and on the true map: the same accuracy within 1 cm.
+TEST(MapBuild, ReplayOnTheBuiltMapIsAsGoodAsOnTheTrueMap) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("lampnav_map_replay_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string drive = (dir / "drive.mcap").string(),
+                    mission = (dir / "mission.mcap").string();
+  ASSERT_EQ(test::run_lampnav("sim --scenario corridor --seed 1 -o '" + drive + "'").status, 0);
+  ASSERT_EQ(test::run_lampnav("sim --scenario corridor --seed 2 -o '" + mission + "'").status, 0);
+  auto start_of = [](const std::string& log) {
+    const Pose2 p = io::read_mission_log(log).truth.front().value.pose;
+    return std::to_string(p.x()) + "," + std::to_string(p.y()) + "," + std::to_string(p.yaw());
+  };
+  // Built in the drive's own frame, then again placed by the best rigid alignment of its lamps
+  // onto the true ones (how the accuracy is defined), so that the replays' errors compare.
+  const std::string built = (dir / "built.geojson").string();
+  auto b = test::run_lampnav("map build '" + drive + "' -o '" + built + "' --quiet");
+  ASSERT_EQ(b.status, 0) << b.err;
+  const graph::TopologicalMap truth =
+      graph::read_map(test::source_path("maps/office_floor.geojson")).map;
+  const Pose2 start = io::read_mission_log(drive).truth.front().value.pose;
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> pairs;
+  for (const auto& n : graph::read_map(built).map.nodes()) {
+    for (const auto& l : n.lamps) {
+      const auto near = truth.lamps_within(start.transform_from(l.xyz.head<2>()), 0.3);
+      if (!near.empty()) pairs.emplace_back(l.xyz.head<2>(), near.front()->xyz.head<2>());
+    }
+  }
+  const Pose2 fit = mapping::fit_rigid(pairs);
+  b = test::run_lampnav("map build '" + drive + "' -o '" + built + "' --quiet --initial-pose " +
+                        std::to_string(fit.x()) + "," + std::to_string(fit.y()) + "," +
+                        std::to_string(fit.yaw()));
+  ASSERT_EQ(b.status, 0) << b.err;
+  double rms[2] = {0, 0};
+  const std::string maps[2] = {built, test::source_path("maps/office_floor.geojson")};
+  for (int k = 0; k < 2; ++k) {
+    const std::string out = (dir / ("replay" + std::to_string(k))).string();
+    const auto r = test::run_lampnav("replay '" + mission + "' --map '" + maps[k] + "' --out '" +
+                                     out + "' -q --initial-pose " + start_of(mission));
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto metrics = nlohmann::json::parse(test::slurp(out + "/metrics.json"));
+    rms[k] = metrics["position_error_m"]["rms"].get<double>();
+    EXPECT_EQ(metrics["wrong_fixes"], 0) << maps[k];
+  }
+  std::cout << "replay position RMS: built map " << rms[0] * 100 << " cm, true map " << rms[1] * 100
+            << " cm\n";
+  EXPECT_LE(std::abs(rms[0] - rms[1]), 0.01);
+  fs::remove_all(dir);
+}
+
 TEST(MapBuild, RefusesWhatCannotMakeAMap) {
   // A log without ceiling frames: the domus scenario records the omni camera only.
   const fs::path dir =

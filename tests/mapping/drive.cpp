@@ -49,4 +49,20 @@ DriveRecord drive_through(const std::vector<Eigen::Vector2d>& waypoints, double 
   return rec;
 }
 
+mapping::MappingResult map_drive(const DriveRecord& drive, const RobotDescription& robot,
+                                 const mapping::LampMapperOptions& options) {
+  mapping::LampMapper mapper(robot, options);
+  std::size_t w = 0;
+  for (const auto& f : drive.frames) {
+    for (; w < drive.wheels.size() && drive.wheels[w].stamp <= f.stamp; ++w)
+      mapper.wheels(drive.wheels[w].stamp, drive.wheels[w].left, drive.wheels[w].right);
+    mapper.ceiling(f.stamp, f.lamps);
+  }
+  return mapper.finish();
+}
+
+std::vector<Eigen::Vector2d> office_every_corridor() {
+  return {{1, 10}, {21, 10}, {41, 10}, {41, -8}, {21, -8}, {1, -8}, {21, -8}, {21, 10}};
+}
+
 }  // namespace lampnav::test

@@ -7,6 +7,7 @@
 
 #include "lampnav/core/pose2.hpp"
 #include "lampnav/core/time.hpp"
+#include "lampnav/mapping/lamp_mapper.hpp"
 #include "lampnav/sim/lamp_sensors.hpp"
 #include "lampnav/vision/lamp_detector.hpp"
 
@@ -35,6 +36,14 @@ struct DriveRecord {
   Pose2 start;
   double length_m = 0;
 };
+
+// The lamp SLAM over a recorded drive, wheels and frames in time order.
+mapping::MappingResult map_drive(const DriveRecord& drive, const RobotDescription& robot,
+                                 const mapping::LampMapperOptions& options = {});
+
+// The office floor's corridors, every one driven once and C6 twice: E1, J1, K1, K2, J2, E2 and
+// back through J2 and C5 to J1.
+std::vector<Eigen::Vector2d> office_every_corridor();
 
 DriveRecord drive_through(const std::vector<Eigen::Vector2d>& waypoints, double start_yaw,
                           const sim::LampSensors& sensors, double semi_axis,

@@ -9,6 +9,7 @@
 #include <iostream>
 #include <set>
 
+#include "battery.hpp"
 #include "drive.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/graph/planner.hpp"
@@ -91,26 +92,18 @@ Accuracy compare(const MappingResult& built, const graph::TopologicalMap& truth,
 
 MappingResult build(const test::DriveRecord& drive, const RobotDescription& robot,
                     const LampMapperOptions& o = {}) {
-  LampMapper mapper(robot, o);
-  std::size_t w = 0;
-  for (const auto& f : drive.frames) {
-    while (w < drive.wheels.size() && drive.wheels[w].stamp <= f.stamp) {
-      mapper.wheels(drive.wheels[w].stamp, drive.wheels[w].left, drive.wheels[w].right);
-      ++w;
-    }
-    mapper.ceiling(f.stamp, f.lamps);
-  }
-  return mapper.finish();
+  return test::map_drive(drive, robot, o);
 }
 
-sim::BuildingOptions test_building() {
-  sim::BuildingOptions o;
-  o.nodes = 100;
-  o.missing_corridors = 1;
-  o.wing_lamp_spacing_m = 2.7;
-  o.lobby = true;
-  o.seed = 5;
-  return o;
+// The targets: every lamp once, none that does not exist; 2 cm RMS, 5 cm at most, heights
+// within 3 cm.
+void expect_targets(const Accuracy& a) {
+  EXPECT_EQ(a.phantoms, 0u);
+  EXPECT_EQ(a.doubles, 0u);
+  EXPECT_EQ(a.missing, 0u);
+  EXPECT_LE(a.rms_m, 0.02);
+  EXPECT_LE(a.max_m, 0.05);
+  EXPECT_LE(a.max_height_m, 0.03);
 }
 
 std::vector<Vector2d> office_loop(int laps) {
@@ -139,12 +132,7 @@ TEST(LampMapper, OfficeLoopDrivenTwiceGivesEachLampOnce) {
             << built.merged << ", dropped " << built.dropped << "); error rms " << a.rms_m * 100
             << " cm, max " << a.max_m * 100 << " cm, height max " << a.max_height_m * 100
             << " cm\n";
-  EXPECT_EQ(a.phantoms, 0u);
-  EXPECT_EQ(a.doubles, 0u);
-  EXPECT_EQ(a.missing, 0u);
-  EXPECT_LE(a.rms_m, 0.02);
-  EXPECT_LE(a.max_m, 0.05);
-  EXPECT_LE(a.max_height_m, 0.03);
+  expect_targets(a);
   EXPECT_GT(built.revisits, 0u);
 }
 
@@ -174,7 +162,7 @@ TEST(LampMapper, LoopClosureTakesOutTheDrift) {
 // A drive of more than ten minutes on a generated 100-node building (rooms, a missing corridor,
 // a wing with another lamp spacing, a lobby): over every corridor, closing loops.
 TEST(LampMapper, TenMinuteDriveOnAGeneratedBuilding) {
-  sim::BuildingOptions bo = test_building();
+  const sim::BuildingOptions bo = test::asymmetric_building(100);
   const graph::TopologicalMap map = graph::parse_map(sim::generate_building(bo).geojson, "b").map;
   const RobotDescription robot =
       read_robot_description(test::source_path("maps/robots/pioneer.json"));
@@ -237,12 +225,7 @@ TEST(LampMapper, TenMinuteDriveOnAGeneratedBuilding) {
             << a.doubles << "); error rms " << a.rms_m * 100 << " cm, max " << a.max_m * 100
             << " cm, height max " << a.max_height_m * 100 << " cm\n";
   EXPECT_GE(drive.length_m, 300.0);
-  EXPECT_EQ(a.phantoms, 0u);
-  EXPECT_EQ(a.doubles, 0u);
-  EXPECT_EQ(a.missing, 0u);
-  EXPECT_LE(a.rms_m, 0.02);
-  EXPECT_LE(a.max_m, 0.05);
-  EXPECT_LE(a.max_height_m, 0.03);
+  expect_targets(a);
 }
 
 }  // namespace

@@ -46,17 +46,9 @@ TEST(Survey, FindsTheFailedMovedAndNewLampsAndNothingElse) {
   sim::LampSensorOptions so;
   so.failed_lamps = {"C1-L3", "C2-L2", "C3-L4"};
   const sim::LampSensors sensors(world, robot, so);
-  const std::vector<Vector2d> route = {{1, 10},  {21, 10}, {41, 10}, {41, -8},
-                                       {21, -8}, {1, -8},  {21, -8}, {21, 10}};
-  const test::DriveRecord drive = test::drive_through(route, 0.0, sensors, robot.semi_axis);
-  LampMapper mapper(robot);
-  std::size_t w = 0;
-  for (const auto& f : drive.frames) {
-    for (; w < drive.wheels.size() && drive.wheels[w].stamp <= f.stamp; ++w)
-      mapper.wheels(drive.wheels[w].stamp, drive.wheels[w].left, drive.wheels[w].right);
-    mapper.ceiling(f.stamp, f.lamps);
-  }
-  const SurveyResult s = survey(map, mapper.finish(), robot);
+  const test::DriveRecord drive =
+      test::drive_through(test::office_every_corridor(), 0.0, sensors, robot.semi_axis);
+  const SurveyResult s = survey(map, test::map_drive(drive, robot), robot);
   std::map<std::string, std::string> found;  // lamp -> status
   for (const auto& f : s.findings) {
     std::cout << to_string(f.status) << " " << f.lamp << " (" << f.where << ")"

@@ -26,17 +26,9 @@ TEST(Topology, OfficeDrivenDownEveryCorridorHasTheTrueTopology) {
   const RobotDescription robot =
       read_robot_description(test::source_path("maps/robots/pioneer.json"));
   const sim::LampSensors sensors(truth, robot);
-  const std::vector<Vector2d> route = {{1, 10},  {21, 10}, {41, 10}, {41, -8},
-                                       {21, -8}, {1, -8},  {21, -8}, {21, 10}};
-  const test::DriveRecord drive = test::drive_through(route, 0.0, sensors, robot.semi_axis);
-  LampMapper mapper(robot);
-  std::size_t w = 0;
-  for (const auto& f : drive.frames) {
-    for (; w < drive.wheels.size() && drive.wheels[w].stamp <= f.stamp; ++w)
-      mapper.wheels(drive.wheels[w].stamp, drive.wheels[w].left, drive.wheels[w].right);
-    mapper.ceiling(f.stamp, f.lamps);
-  }
-  const MappingResult mapped = mapper.finish();
+  const test::DriveRecord drive =
+      test::drive_through(test::office_every_corridor(), 0.0, sensors, robot.semi_axis);
+  const MappingResult mapped = test::map_drive(drive, robot);
   TopologyReport rep;
   const graph::TopologicalMap built = build_topology(mapped, {}, {}, &rep);
   // It is a valid map: written and read back by the map reader's rules.

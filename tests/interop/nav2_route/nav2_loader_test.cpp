@@ -160,14 +160,8 @@ TEST(Nav2Loader, LoadsABuiltMap) {
   const test::DriveRecord drive = test::drive_through(
       {{1, 10}, {21, 10}, {41, 10}, {41, -8}, {21, -8}, {1, -8}, {21, -8}, {21, 10}}, 0.0, sensors,
       robot.semi_axis);
-  mapping::LampMapper mapper(robot);
-  std::size_t w = 0;
-  for (const auto& f : drive.frames) {
-    for (; w < drive.wheels.size() && drive.wheels[w].stamp <= f.stamp; ++w)
-      mapper.wheels(drive.wheels[w].stamp, drive.wheels[w].left, drive.wheels[w].right);
-    mapper.ceiling(f.stamp, f.lamps);
-  }
-  const graph::TopologicalMap built = mapping::build_topology(mapper.finish(), {}, {}, nullptr);
+  const graph::TopologicalMap built =
+      mapping::build_topology(test::map_drive(drive, robot), {}, {}, nullptr);
   ASSERT_GT(built.edge_count(), 0u);
   expect_nav2_loads_alike(write_temp("built", graph::write_map(built)));
 }

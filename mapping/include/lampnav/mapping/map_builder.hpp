@@ -5,6 +5,7 @@
 // never read: the map comes from the drive alone.
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,7 +26,10 @@ struct MapBuildOptions {
   TopologyOptions topology;
   vision::LampDetectorOptions detector;
   int probe_frames = 300;  // frames spread over the drive from which the lamps' look is learnt
-  void validate() const;   // throws InputError naming the field
+  // Where the drive started, in the frame the map should have (an existing map's, a floor plan's);
+  // without it the map's frame is the start itself (x forward, y left).
+  std::optional<Pose2> start;
+  void validate() const;  // throws InputError naming the field
 };
 
 // The lamps of a recorded drive (the first half of a map build; a survey's whole input).
@@ -34,6 +38,8 @@ struct DriveLamps {
   vision::LampShapePrior prior;  // learnt: the lamps' size seen from unit distance
   std::size_t frames = 0, unreadable_frames = 0, lamps_seen_whole = 0;
   double travel_m = 0;
+  double detect_seconds = 0;       // learning the lamps' look and detecting them in every frame
+  double slam_seconds = 0;         // the lamp SLAM, solves included
   std::vector<std::string> notes;  // for the user
 };
 
