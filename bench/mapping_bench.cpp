@@ -6,11 +6,14 @@
 #include <benchmark/benchmark.h>
 
 #include <unistd.h>
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/mapping/map_builder.hpp"
+#include "lampnav/mapping/rigid_fit.hpp"
 #include "lampnav/sim/building.hpp"
 #include "lampnav/sim/scenario.hpp"
 
@@ -33,17 +36,46 @@ void BM_MapBuildFromLog(benchmark::State& state) {
                                 ("lampnav_map_bench_" + std::to_string(::getpid()) + ".mcap"))
                                    .string();
   const auto stats = sim::record_mission(s, log_path, {});
-  double drive_s = 0, lamps = 0;
+  double drive_s = 0;
+  graph::TopologicalMap built;
+  Pose2 start;
   for (auto _ : state) {
     const io::MissionLog log = io::read_mission_log(log_path);
     const mapping::MapBuildResult r = mapping::build_map(log, log_path, robot, {}, {});
-    lamps = static_cast<double>(r.map.lamp_count());
+    built = r.map;
+    start = log.truth.front().value.pose;
     drive_s = to_seconds(log.wheels.back().value.stamp - log.wheels.front().value.stamp);
     benchmark::DoNotOptimize(r);
   }
   std::filesystem::remove(log_path);
+  // Accuracy against the truth, after the best rigid alignment (not timed).
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> pairs;
+  std::vector<double> dz;
+  double phantoms = 0;
+  for (const auto& n : built.nodes()) {
+    for (const auto& l : n.lamps) {
+      const auto near = map.lamps_within(start.transform_from(l.xyz.head<2>()), 0.5);
+      if (near.empty()) {
+        ++phantoms;
+        continue;
+      }
+      pairs.emplace_back(l.xyz.head<2>(), near.front()->xyz.head<2>());
+      dz.push_back(std::abs(l.xyz.z() - near.front()->xyz.z()));
+    }
+  }
+  const Pose2 fit = mapping::fit_rigid(pairs);
+  double sum = 0, worst = 0;
+  for (const auto& [mapped, true_xy] : pairs) {
+    const double e = (fit.transform_from(mapped) - true_xy).norm();
+    sum += e * e;
+    worst = std::max(worst, e);
+  }
   state.counters["drive_min"] = drive_s / 60;
-  state.counters["lamps"] = lamps;
+  state.counters["lamps"] = static_cast<double>(built.lamp_count());
+  state.counters["phantoms"] = phantoms;
+  state.counters["rms_cm"] = pairs.empty() ? 0 : 100 * std::sqrt(sum / pairs.size());
+  state.counters["max_cm"] = 100 * worst;
+  state.counters["height_max_cm"] = dz.empty() ? 0 : 100 * *std::max_element(dz.begin(), dz.end());
   (void)stats;
 }
 BENCHMARK(BM_MapBuildFromLog)->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
