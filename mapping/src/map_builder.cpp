@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "lampnav/core/error.hpp"
+#include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
 
 namespace lampnav::mapping {

@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "lampnav/core/error.hpp"
+#include "lampnav/graph/geojson.hpp"
 
 namespace lampnav::mapping {
 
@@ -284,12 +285,65 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     nodes.push_back(std::move(n));
   }
 
+  // Regions must not overlap (map-format.md): where the drive's geometry makes two meet at an
+  // angle, the corridor gives way (shortened at that end), or the later of two places shrinks; a
+  // corridor shorter than half a metre, or a place smaller than that, is left out.
+  std::vector<bool> dropped(nodes.size(), false);
+  const double allowed = 0.5 * graph::kRegionOverlapTolerance;
+  auto overlap = [&](std::size_t a, std::size_t b) {
+    const auto &ra = nodes[a].region, &rb = nodes[b].region;
+    if (!ra.bounds().intersects(rb.bounds())) return 0.0;
+    return graph::intersection_area(ra, rb);
+  };
+  for (std::size_t b = 0; b < nodes.size(); ++b) {
+    for (std::size_t a = 0; a < b && !dropped[b]; ++a) {
+      if (dropped[a]) continue;
+      for (int step = 0; step < 40 && !dropped[b] && overlap(a, b) > allowed; ++step) {
+        // The one to give way: a corridor before a place, else the later one.
+        const std::size_t g = nodes[b].axis || !nodes[a].axis ? b : a;
+        graph::Node& n = nodes[g];
+        const graph::Node& other = nodes[g == b ? a : b];
+        if (n.axis) {
+          graph::Axis& ax = *n.axis;
+          const Vector2d c = other.region.centroid();
+          const Vector2d d = ax.direction() * 0.1;
+          if ((ax.first - c).norm() < (ax.second - c).norm())
+            ax.first += d;
+          else
+            ax.second -= d;
+          if (ax.length() < 0.5) {
+            dropped[g] = true;
+            break;
+          }
+          n.region = rectangle(ax.first, ax.second, w);
+          n.point = 0.5 * (ax.first + ax.second);
+        } else {
+          const auto& v = n.region.vertices();
+          std::vector<Vector2d> smaller;
+          for (const auto& p : v) smaller.push_back(n.point + 0.9 * (p - n.point));
+          n.region = graph::Polygon(smaller);
+          if ((smaller[0] - smaller[1]).norm() < 0.5) {
+            dropped[g] = true;
+            break;
+          }
+        }
+        if (dropped[a]) break;
+      }
+    }
+  }
+  std::size_t left_out = 0;
+  for (std::size_t i = 0; i < nodes.size(); ++i) left_out += dropped[i];
+  if (left_out)
+    rep.notes.push_back(std::to_string(left_out) +
+                        " places were left out: their regions would overlap others (the drive "
+                        "met them at an angle)");
+
   // 5. Lamps into the place whose region holds them, in walking order.
   std::vector<std::vector<const MappedLamp*>> held(nodes.size());
   for (const auto& l : mapped.lamps) {
     int at = -1;
     for (std::size_t i = 0; i < nodes.size() && at < 0; ++i)
-      if (nodes[i].region.contains(l.xyz.head<2>(), 1e-6)) at = static_cast<int>(i);
+      if (!dropped[i] && nodes[i].region.contains(l.xyz.head<2>(), 1e-6)) at = static_cast<int>(i);
     if (at < 0) {
       ++rep.lamps_outside;
       continue;
@@ -317,13 +371,16 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
       n.lamps.push_back(lamp);
     }
   }
-  for (auto& n : nodes) map.add_node(n);
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    if (!dropped[i]) map.add_node(nodes[i]);
 
   // 6. Edges: each corridor to the places at its ends, both ways.
   std::int64_t next_edge = 1000;
   for (std::size_t i = 0; i < corridors.size(); ++i) {
+    if (dropped[corridor_node[i]]) continue;
     const graph::Node& c = nodes[corridor_node[i]];
     for (const int pl : {corridors[i].from, corridors[i].to}) {
+      if (dropped[places[pl].node]) continue;
       const graph::Node& q = nodes[places[pl].node];
       for (const auto& [s, e] : {std::pair{&c, &q}, std::pair{&q, &c}}) {
         graph::Edge edge;

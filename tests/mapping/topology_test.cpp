@@ -77,5 +77,22 @@ TEST(Topology, OfficeDrivenDownEveryCorridorHasTheTrueTopology) {
             << built.lamp_count() << " lamps\n";
 }
 
+// A drive that leaves a corridor at 45 degrees and back (through walls, as a drive with a kidnap
+// in it would look): regions that would overlap give way, and the map still reads back.
+TEST(Topology, RegionsMetAtAnAngleGiveWay) {
+  const graph::TopologicalMap office =
+      graph::read_map(test::source_path("maps/office_floor.geojson")).map;
+  const RobotDescription robot =
+      read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  const sim::LampSensors sensors(office, robot);
+  const test::DriveRecord drive = test::drive_through(
+      {{1, 10}, {21, 10}, {28, 3}, {21, 10}, {41, 10}}, 0.0, sensors, robot.semi_axis);
+  TopologyReport rep;
+  const graph::TopologicalMap built = build_topology(test::map_drive(drive, robot), {}, {}, &rep);
+  EXPECT_GT(built.node_count(), 2u);
+  EXPECT_NO_THROW(graph::parse_map(graph::write_map(built), "built"));
+  for (const auto& note : rep.notes) std::cout << note << "\n";
+}
+
 }  // namespace
 }  // namespace lampnav::mapping
