@@ -2,6 +2,9 @@
 
 #include <cmath>
 
+#include "lampnav/graph/geojson.hpp"
+#include "lampnav_test.hpp"
+
 namespace lampnav::test {
 
 DriveRecord drive_through(const std::vector<Eigen::Vector2d>& waypoints, double start_yaw,
@@ -59,6 +62,17 @@ mapping::MappingResult map_drive(const DriveRecord& drive, const RobotDescriptio
     mapper.ceiling(f.stamp, f.lamps);
   }
   return mapper.finish();
+}
+
+Office::Office()
+    : map(graph::read_map(source_path("maps/office_floor.geojson")).map),
+      robot(read_robot_description(source_path("maps/robots/pioneer.json"))) {}
+
+DriveRecord Office::drive(const std::vector<Eigen::Vector2d>& waypoints,
+                          const DriveOptions& options) const {
+  const sim::LampSensors sensors(map, robot);
+  const Eigen::Vector2d d = waypoints[1] - waypoints[0];
+  return drive_through(waypoints, std::atan2(d.y(), d.x()), sensors, robot.semi_axis, options);
 }
 
 std::vector<Eigen::Vector2d> office_every_corridor() {

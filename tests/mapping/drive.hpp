@@ -7,6 +7,7 @@
 
 #include "lampnav/core/pose2.hpp"
 #include "lampnav/core/time.hpp"
+#include "lampnav/graph/map.hpp"
 #include "lampnav/mapping/lamp_mapper.hpp"
 #include "lampnav/sim/lamp_sensors.hpp"
 #include "lampnav/vision/lamp_detector.hpp"
@@ -48,5 +49,15 @@ std::vector<Eigen::Vector2d> office_every_corridor();
 DriveRecord drive_through(const std::vector<Eigen::Vector2d>& waypoints, double start_yaw,
                           const sim::LampSensors& sensors, double semi_axis,
                           const DriveOptions& options = {});
+
+// The bundled office floor and robot, driven with the ideal detections of its working lamps.
+struct Office {
+  graph::TopologicalMap map;
+  RobotDescription robot;
+  Office();
+  // Through the waypoints from the first, facing the second.
+  DriveRecord drive(const std::vector<Eigen::Vector2d>& waypoints,
+                    const DriveOptions& options = {}) const;
+};
 
 }  // namespace lampnav::test

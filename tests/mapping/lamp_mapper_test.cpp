@@ -22,10 +22,7 @@ namespace {
 
 using Eigen::Vector2d;
 
-struct Office {
-  graph::TopologicalMap map = graph::read_map(test::source_path("maps/office_floor.geojson")).map;
-  RobotDescription robot = read_robot_description(test::source_path("maps/robots/pioneer.json"));
-};
+using test::Office;
 
 struct Accuracy {
   std::size_t matched = 0, missing = 0, phantoms = 0, doubles = 0;
@@ -119,9 +116,7 @@ std::vector<Vector2d> office_loop(int laps) {
 
 TEST(LampMapper, OfficeLoopDrivenTwiceGivesEachLampOnce) {
   const Office office;
-  const sim::LampSensors sensors(office.map, office.robot);
-  const test::DriveRecord drive =
-      test::drive_through(office_loop(2), 0.0, sensors, office.robot.semi_axis);
+  const test::DriveRecord drive = office.drive(office_loop(2));
   const MappingResult built = build(drive, office.robot);
   const Accuracy a = compare(built, office.map, drive);
   std::cout << "drive " << drive.length_m << " m, " << built.keyframes.size() << " keyframes, "
@@ -139,11 +134,9 @@ TEST(LampMapper, OfficeLoopDrivenTwiceGivesEachLampOnce) {
 // Without loop closure the second lap's lamps are new landmarks, drifted; with it, one each.
 TEST(LampMapper, LoopClosureTakesOutTheDrift) {
   const Office office;
-  const sim::LampSensors sensors(office.map, office.robot);
   test::DriveOptions dopt;
   dopt.seed = 2;
-  const test::DriveRecord drive =
-      test::drive_through(office_loop(2), 0.0, sensors, office.robot.semi_axis, dopt);
+  const test::DriveRecord drive = office.drive(office_loop(2), dopt);
   LampMapperOptions open;
   open.close_loops = false;
   const Accuracy without = compare(build(drive, office.robot, open), office.map, drive);

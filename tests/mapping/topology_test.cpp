@@ -21,14 +21,10 @@ namespace {
 using Eigen::Vector2d;
 
 TEST(Topology, OfficeDrivenDownEveryCorridorHasTheTrueTopology) {
-  const graph::TopologicalMap truth =
-      graph::read_map(test::source_path("maps/office_floor.geojson")).map;
-  const RobotDescription robot =
-      read_robot_description(test::source_path("maps/robots/pioneer.json"));
-  const sim::LampSensors sensors(truth, robot);
-  const test::DriveRecord drive =
-      test::drive_through(test::office_every_corridor(), 0.0, sensors, robot.semi_axis);
-  const MappingResult mapped = test::map_drive(drive, robot);
+  const test::Office office;
+  const graph::TopologicalMap& truth = office.map;
+  const test::DriveRecord drive = office.drive(test::office_every_corridor());
+  const MappingResult mapped = test::map_drive(drive, office.robot);
   TopologyReport rep;
   const graph::TopologicalMap built = build_topology(mapped, {}, {}, &rep);
   // It is a valid map: written and read back by the map reader's rules.
@@ -80,15 +76,11 @@ TEST(Topology, OfficeDrivenDownEveryCorridorHasTheTrueTopology) {
 // A drive that leaves a corridor at 45 degrees and back (through walls, as a drive with a kidnap
 // in it would look): regions that would overlap give way, and the map still reads back.
 TEST(Topology, RegionsMetAtAnAngleGiveWay) {
-  const graph::TopologicalMap office =
-      graph::read_map(test::source_path("maps/office_floor.geojson")).map;
-  const RobotDescription robot =
-      read_robot_description(test::source_path("maps/robots/pioneer.json"));
-  const sim::LampSensors sensors(office, robot);
-  const test::DriveRecord drive = test::drive_through(
-      {{1, 10}, {21, 10}, {28, 3}, {21, 10}, {41, 10}}, 0.0, sensors, robot.semi_axis);
+  const test::Office office;
+  const test::DriveRecord drive = office.drive({{1, 10}, {21, 10}, {28, 3}, {21, 10}, {41, 10}});
   TopologyReport rep;
-  const graph::TopologicalMap built = build_topology(test::map_drive(drive, robot), {}, {}, &rep);
+  const graph::TopologicalMap built =
+      build_topology(test::map_drive(drive, office.robot), {}, {}, &rep);
   EXPECT_GT(built.node_count(), 2u);
   EXPECT_NO_THROW(graph::parse_map(graph::write_map(built), "built"));
   for (const auto& note : rep.notes) std::cout << note << "\n";

@@ -152,16 +152,10 @@ TEST(Nav2Loader, LoadsGeneratedBuildings) {
 
 // A map built from a drive down every corridor of the office (mapping/), as `map build` writes it.
 TEST(Nav2Loader, LoadsABuiltMap) {
-  const graph::TopologicalMap office =
-      graph::read_map(test::source_path("maps/office_floor.geojson")).map;
-  const RobotDescription robot =
-      read_robot_description(test::source_path("maps/robots/pioneer.json"));
-  const sim::LampSensors sensors(office, robot);
-  const test::DriveRecord drive = test::drive_through(
-      {{1, 10}, {21, 10}, {41, 10}, {41, -8}, {21, -8}, {1, -8}, {21, -8}, {21, 10}}, 0.0, sensors,
-      robot.semi_axis);
+  const test::Office office;
+  const test::DriveRecord drive = office.drive(test::office_every_corridor());
   const graph::TopologicalMap built =
-      mapping::build_topology(test::map_drive(drive, robot), {}, {}, nullptr);
+      mapping::build_topology(test::map_drive(drive, office.robot), {}, {}, nullptr);
   ASSERT_GT(built.edge_count(), 0u);
   expect_nav2_loads_alike(write_temp("built", graph::write_map(built)));
 }
