@@ -2,7 +2,10 @@
 
 #include <cmath>
 
+#include <algorithm>
+
 #include "lampnav/graph/geojson.hpp"
+#include "lampnav/graph/planner.hpp"
 #include "lampnav_test.hpp"
 
 namespace lampnav::test {
@@ -73,6 +76,45 @@ DriveRecord Office::drive(const std::vector<Eigen::Vector2d>& waypoints,
   const sim::LampSensors sensors(map, robot);
   const Eigen::Vector2d d = waypoints[1] - waypoints[0];
   return drive_through(waypoints, std::atan2(d.y(), d.x()), sensors, robot.semi_axis, options);
+}
+
+std::vector<Eigen::Vector2d> every_corridor_twice(const graph::TopologicalMap& map) {
+  std::vector<const graph::Node*> places;
+  for (const auto& n : map.nodes())
+    if (n.place == graph::Place::junction || n.place == graph::Place::corner) places.push_back(&n);
+  std::vector<NodeId> targets;
+  auto serpentine = [&](bool by_rows) {
+    std::vector<const graph::Node*> sorted = places;
+    auto key = [by_rows](const graph::Node* n) {
+      return by_rows ? std::make_pair(std::round(n->point.y()), n->point.x())
+                     : std::make_pair(std::round(n->point.x()), n->point.y());
+    };
+    std::sort(sorted.begin(), sorted.end(),
+              [&](const auto* a, const auto* b) { return key(a) < key(b); });
+    std::vector<std::vector<const graph::Node*>> lines;
+    for (const auto* p : sorted) {
+      if (lines.empty() || key(lines.back().front()).first != key(p).first) lines.emplace_back();
+      lines.back().push_back(p);
+    }
+    for (std::size_t r = 0; r < lines.size(); ++r) {
+      if (r % 2) std::reverse(lines[r].begin(), lines[r].end());
+      for (const auto* p : lines[r]) targets.push_back(p->id);
+    }
+  };
+  serpentine(true);
+  serpentine(false);
+  std::vector<Eigen::Vector2d> waypoints = {map.node(targets.front()).point};
+  for (std::size_t i = 1; i < targets.size(); ++i) {
+    if (targets[i] == targets[i - 1]) continue;
+    const auto route = graph::plan_route(map, targets[i - 1], targets[i]);
+    if (!route) continue;  // a place the missing corridors cut off
+    for (std::size_t k = 1; k < route->nodes.size(); ++k) {
+      const graph::Node& n = map.node(route->nodes[k]);
+      if (n.place == graph::Place::junction || n.place == graph::Place::corner)
+        waypoints.push_back(n.point);
+    }
+  }
+  return waypoints;
 }
 
 std::vector<Eigen::Vector2d> office_every_corridor() {

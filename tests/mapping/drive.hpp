@@ -42,6 +42,11 @@ struct DriveRecord {
 mapping::MappingResult map_drive(const DriveRecord& drive, const RobotDescription& robot,
                                  const mapping::LampMapperOptions& options = {});
 
+// Through a grid building's junctions and corners, row by row (serpentine), then column by
+// column: every corridor driven, every junction passed twice (which closes the loops). The path
+// follows the map's routes between them.
+std::vector<Eigen::Vector2d> every_corridor_twice(const graph::TopologicalMap& map);
+
 // The office floor's corridors, every one driven once and C6 twice: E1, J1, K1, K2, J2, E2 and
 // back through J2 and C5 to J1.
 std::vector<Eigen::Vector2d> office_every_corridor();

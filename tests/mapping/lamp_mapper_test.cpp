@@ -159,45 +159,7 @@ TEST(LampMapper, TenMinuteDriveOnAGeneratedBuilding) {
   const graph::TopologicalMap map = graph::parse_map(sim::generate_building(bo).geojson, "b").map;
   const RobotDescription robot =
       read_robot_description(test::source_path("maps/robots/pioneer.json"));
-  // Junctions and corners by grid position.
-  std::vector<const graph::Node*> places;
-  for (const auto& n : map.nodes())
-    if (n.place == graph::Place::junction || n.place == graph::Place::corner) places.push_back(&n);
-  // Serpentine over the rows (each row left to right, the next right to left), then over the
-  // columns: every corridor driven, and every junction passed again on the second pass, which
-  // closes the loops.
-  std::vector<NodeId> targets;
-  auto serpentine = [&](bool by_rows) {
-    std::vector<const graph::Node*> sorted = places;
-    auto key = [by_rows](const graph::Node* n) {
-      return by_rows ? std::make_pair(std::round(n->point.y()), n->point.x())
-                     : std::make_pair(std::round(n->point.x()), n->point.y());
-    };
-    std::sort(sorted.begin(), sorted.end(),
-              [&](const auto* a, const auto* b) { return key(a) < key(b); });
-    std::vector<std::vector<const graph::Node*>> lines;
-    for (const auto* p : sorted) {
-      if (lines.empty() || key(lines.back().front()).first != key(p).first) lines.emplace_back();
-      lines.back().push_back(p);
-    }
-    for (std::size_t r = 0; r < lines.size(); ++r) {
-      if (r % 2) std::reverse(lines[r].begin(), lines[r].end());
-      for (const auto* p : lines[r]) targets.push_back(p->id);
-    }
-  };
-  serpentine(true);
-  serpentine(false);
-  std::vector<Vector2d> waypoints = {map.node(targets.front()).point};
-  for (std::size_t i = 1; i < targets.size(); ++i) {
-    if (targets[i] == targets[i - 1]) continue;
-    const auto route = graph::plan_route(map, targets[i - 1], targets[i]);
-    ASSERT_TRUE(route);
-    for (std::size_t k = 1; k < route->nodes.size(); ++k) {
-      const graph::Node& n = map.node(route->nodes[k]);
-      if (n.place == graph::Place::junction || n.place == graph::Place::corner)
-        waypoints.push_back(n.point);
-    }
-  }
+  const std::vector<Vector2d> waypoints = test::every_corridor_twice(map);
   const sim::LampSensors sensors(map, robot);
   const Vector2d d0 = waypoints[1] - waypoints[0];
   // Wheels whose mean scale was calibrated (one 0.35 % larger, the other as much smaller): the
