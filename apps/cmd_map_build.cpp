@@ -44,16 +44,6 @@ std::vector<mapping::PlaceName> read_names(const std::string& path) {
   return names;
 }
 
-// --robot, else the log's robot.json attachment.
-RobotDescription robot_for(const io::MissionLog& log, const std::string& log_path,
-                           const std::string& robot_path) {
-  if (!robot_path.empty()) return read_robot_description(robot_path);
-  if (log.robot_json)
-    return parse_robot_description(*log.robot_json, log_path + " (robot.json attachment)");
-  throw InputError({log_path, "attachments", "robot.json"},
-                   "the log has no robot.json: give --robot");
-}
-
 int run_build(const BuildArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::vector<mapping::PlaceName> names =
@@ -61,7 +51,7 @@ int run_build(const BuildArgs& a) {
   const io::MissionLog log = io::read_mission_log(a.log);
   const double read_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const RobotDescription robot = robot_for(log, a.log, a.robot);
+  const RobotDescription robot = robot_for_log(log, a.log, a.robot);
   mapping::MapBuildOptions o;
   o.topology.corridor_width_m = a.corridor_width;
   if (!a.initial_pose.empty()) o.start = parse_pose_option(a.initial_pose, "--initial-pose");
@@ -108,7 +98,7 @@ int run_survey(const SurveyArgs& a) {
   const graph::LoadedMap loaded = graph::read_map(a.map);
   for (const auto& w : loaded.warnings) diagnostic("warning", w.text());
   const io::MissionLog log = io::read_mission_log(a.log);
-  const RobotDescription robot = robot_for(log, a.log, a.robot);
+  const RobotDescription robot = robot_for_log(log, a.log, a.robot);
   ProgressBar bar(a.quiet || a.json);
   const mapping::DriveLamps drive = mapping::map_drive_lamps(
       log, a.log, robot, {}, [&bar](double f) { bar.update(f, "mapping the drive"); });

@@ -197,18 +197,8 @@ int run_replay(const ReplayArgs& a) {
     throw InputError({a.log, "attachments", "map.geojson"}, "the log has no map: give --map");
   }
   const graph::LoadedMap loaded = graph::parse_map(map_text, map_source);
-  RobotDescription robot;
   std::string robot_json;
-  if (!a.robot.empty()) {
-    robot_json = json::read_file(a.robot);
-    robot = parse_robot_description(robot_json, a.robot);
-  } else if (log.robot_json) {
-    robot_json = *log.robot_json;
-    robot = parse_robot_description(robot_json, a.log + " (robot.json attachment)");
-  } else {
-    throw InputError({a.log, "attachments", "robot.json"},
-                     "the log has no robot.json: give --robot");
-  }
+  const RobotDescription robot = robot_for_log(log, a.log, a.robot, &robot_json);
   navigation::ReplayOptions o;
   o.use_ceiling = !a.no_ceiling;
   o.use_omni = !a.no_omni;

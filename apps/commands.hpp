@@ -8,9 +8,14 @@
 #include <string>
 
 #include "lampnav/core/pose2.hpp"
+#include "lampnav/core/robot_description.hpp"
 
 namespace CLI {
 class App;
+}
+
+namespace lampnav::io {
+struct MissionLog;
 }
 
 namespace lampnav::apps {
@@ -39,6 +44,11 @@ class ProgressBar {
   bool show_;
   int last_ = -1;
 };
+
+// The robot of a command reading a log: `robot_path` when given, else the log's robot.json
+// attachment; InputError naming the log otherwise. `text`, when given, receives the JSON read.
+RobotDescription robot_for_log(const io::MissionLog& log, const std::string& log_path,
+                               const std::string& robot_path, std::string* text = nullptr);
 
 // X,Y,YAW (m, m, rad) from a command-line option; InputError naming `flag` otherwise.
 Pose2 parse_pose_option(const std::string& text, const std::string& flag);

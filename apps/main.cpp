@@ -13,6 +13,8 @@
 
 #include "commands.hpp"
 #include "lampnav/core/error.hpp"
+#include "lampnav/internal/json_util.hpp"
+#include "lampnav/io/mission_log.hpp"
 
 namespace lampnav::apps {
 void diagnostic(const std::string& kind, const std::string& text) {
@@ -43,6 +45,25 @@ Pose2 parse_pose_option(const std::string& text, const std::string& flag) {
     throw InputError({"", flag, ""},
                      "expected X,Y,YAW (metres, metres, radians), found '" + text + "'");
   return Pose2(v[0], v[1], wrap_angle(v[2]));
+}
+
+RobotDescription robot_for_log(const io::MissionLog& log, const std::string& log_path,
+                               const std::string& robot_path, std::string* text) {
+  std::string json_text;
+  std::string source;
+  if (!robot_path.empty()) {
+    json_text = json::read_file(robot_path);
+    source = robot_path;
+  } else if (log.robot_json) {
+    json_text = *log.robot_json;
+    source = log_path + " (robot.json attachment)";
+  } else {
+    throw InputError({log_path, "attachments", "robot.json"},
+                     "the log has no robot.json: give --robot");
+  }
+  RobotDescription robot = parse_robot_description(json_text, source);
+  if (text) *text = std::move(json_text);
+  return robot;
 }
 
 ProgressBar::ProgressBar(bool quiet) : show_(!quiet && ::isatty(2)) {}

@@ -86,10 +86,8 @@ OJson edge_properties(const TopologicalMap& map, const Edge& e) {
     props["cost"] = e.cost;
     props["overridable"] = false;
   }
-  OJson kept = OJson::object();
-  append_kept(kept, e.nav2_keys);
-  if (!map.plain_nav2() && !kept.contains("metadata")) props["metadata"] = OJson::object();
-  for (auto it = kept.begin(); it != kept.end(); ++it) props[it.key()] = it.value();
+  if (!map.plain_nav2()) props["metadata"] = OJson::object();  // Nav2's kept one replaces it
+  append_kept(props, e.nav2_keys);
   return props;
 }
 

@@ -32,6 +32,10 @@ std::string quoted(const std::string& name) {
 
 std::string ordinal_word(int n) {
   if (n >= 1 && n <= 10) return kOrdinals[n - 1];
+  return ordinal_number(n);
+}
+
+std::string ordinal_number(int n) {
   const int mod100 = n % 100, mod10 = n % 10;
   const char* suffix = (mod100 >= 11 && mod100 <= 13) ? "th"
                        : mod10 == 1                   ? "st"

@@ -3,12 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <optional>
 
 #include "back_end.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/ceiling_geometry.hpp"
 #include "lampnav/fusion/odometry_track.hpp"
+#include "median.hpp"
 
 namespace lampnav::mapping {
 
@@ -47,12 +47,11 @@ struct LampMapper::Impl {
   fusion::CeilingGeometry geometry;
   double focal_px;
   fusion::OdometryTrack track;
-  std::optional<std::pair<double, double>> last_wheels;
   std::vector<std::pair<Stamp, std::array<double, 2>>> wheel_log;  // cumulative readings
   MappingProblem pb;
-  std::vector<Stamp> stamps;               // per keyframe
-  std::vector<std::vector<double>> sizes;  // per landmark: (length, width) sightings
-  std::vector<std::vector<double>> widths;
+  std::vector<Stamp> stamps;  // per keyframe
+  // Per landmark, the lengths and widths of its sightings (m, at the guessed height).
+  std::vector<std::vector<double>> sizes, widths;
   std::vector<double> last_seen_travel;  // per landmark
   double next_solve_m;
   bool square_set = false;
@@ -64,7 +63,7 @@ struct LampMapper::Impl {
       : o(options),
         camera(ceiling_of(robot)),
         geometry(camera),
-        focal_px(camera.model == CameraModelKind::pinhole ? camera.pinhole.fx : 300.0),
+        focal_px(camera.pinhole.fx),
         track(robot.semi_axis, std::chrono::hours(24 * 365)),
         next_solve_m(options.solve_every_m) {
     o.validate();
@@ -76,6 +75,9 @@ struct LampMapper::Impl {
     if (!c)
       throw InputError({"robot.json", "", "cameras"},
                        "no camera named \"ceiling_camera\": the map is built from its lamps");
+    if (c->model != CameraModelKind::pinhole)
+      throw InputError({"robot.json", "camera ceiling_camera", "model"},
+                       "the ceiling camera must be a pinhole camera (as the lamp detector needs)");
     return *c;
   }
 
@@ -127,11 +129,15 @@ struct LampMapper::Impl {
       const double range = z0 - cam.z();
       const double length = d.length * range, width = d.width * range;
       const bool rect = length > 1.5 * width;
+      const double reach = o.gate_m + 2.0 * base->norm() + 0.5;
       int best = -1;
       double best_d = o.gate_m;
       for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
         if (taken[i] || pb.rectangle[i] != rect) continue;
         if (!o.close_loops && travel - last_seen_travel[i] > kRevisitM) continue;
+        // Far from the guess even for a lamp three times as high above the camera: not a
+        // candidate (the placement below moves with the height, by the offset from the robot).
+        if ((at - Vector2d(pb.lamps[i][0], pb.lamps[i][1])).norm() > reach) continue;
         // Place the candidate with its own height: parallax matters at a metre of offset.
         const auto b = geometry.base_point(d.centre, pb.lamps[i][2]);
         if (!b) continue;
@@ -206,27 +212,19 @@ LampMapper::LampMapper(LampMapper&&) noexcept = default;
 void LampMapper::wheels(Stamp stamp, double left, double right) {
   Impl& m = *impl_;
   if (!std::isfinite(left) || !std::isfinite(right)) return;
-  if (!m.wheel_log.empty() && stamp <= m.wheel_log.back().first) return;
-  if (!m.last_wheels) {
+  if (m.wheel_log.empty()) {
     m.track.add(stamp, 0, 0);
   } else {
-    m.track.add(stamp, left - m.last_wheels->first, right - m.last_wheels->second);
+    const auto& [last_stamp, last] = m.wheel_log.back();
+    if (stamp <= last_stamp) return;
+    m.track.add(stamp, left - last[0], right - last[1]);
   }
-  m.last_wheels = {left, right};
   m.wheel_log.push_back({stamp, {left, right}});
 }
 
 void LampMapper::ceiling(Stamp stamp, const std::vector<vision::LampDetection>& lamps) {
   impl_->add_frame(stamp, lamps);
 }
-
-namespace {
-double median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-}  // namespace
 
 MappingResult LampMapper::finish() {
   Impl& m = *impl_;
@@ -235,23 +233,22 @@ MappingResult LampMapper::finish() {
   // Landmarks of one kind that the solve brought together are one lamp (a lamp first seen again
   // with more drift than the gate): their sightings move to the first, and the problem is solved
   // again.
+  // (Without loop closure, no merging either: that is what it would leave.)
   std::vector<int> into(pb.lamps.size(), -1);
-  std::vector<int> count(pb.lamps.size(), 0);
-  for (const auto& s : pb.sightings) ++count[s.lamp];
   bool merged = false;
-  for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
+  for (std::size_t i = 0; m.o.close_loops && i < pb.lamps.size(); ++i) {
     if (into[i] >= 0) continue;
     for (std::size_t j = i + 1; j < pb.lamps.size(); ++j) {
       if (into[j] >= 0 || pb.rectangle[i] != pb.rectangle[j]) continue;
       const Vector2d d(pb.lamps[i][0] - pb.lamps[j][0], pb.lamps[i][1] - pb.lamps[j][1]);
-      if (d.norm() < m.o.merge_m && m.o.close_loops) {
+      if (d.norm() < m.o.merge_m) {
         into[j] = static_cast<int>(i);
         ++m.result.merged;
         merged = true;
       }
     }
   }
-  if (merged && m.o.close_loops) {
+  if (merged) {
     for (auto& s : pb.sightings) {
       if (into[s.lamp] >= 0) {
         const int to = into[s.lamp];

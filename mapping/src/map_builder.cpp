@@ -9,6 +9,7 @@
 #include "lampnav/core/error.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
+#include "median.hpp"
 
 namespace lampnav::mapping {
 
@@ -21,11 +22,6 @@ void MapBuildOptions::validate() const {
 }
 
 namespace {
-
-double median(std::vector<double> v) {
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 // A detector that takes any bright blob from a few centimetres to metres across, for learning
 // what the building's lamps look like.

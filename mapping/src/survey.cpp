@@ -7,6 +7,7 @@
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/ceiling_geometry.hpp"
+#include "lampnav/graph/route_commands.hpp"
 #include "lampnav/mapping/rigid_fit.hpp"
 #include "lampnav/vision/camera_models.hpp"
 
@@ -45,16 +46,6 @@ bool same_kind(graph::LampShape shape, double length, const graph::Lamp& l) {
   return shape == l.shape && std::abs(length - l.length) < 0.25 * std::max(l.length, 0.1);
 }
 
-std::string ordinal(int n) {
-  const int t = n % 100;
-  const char* suffix = (t >= 11 && t <= 13) ? "th"
-                       : n % 10 == 1        ? "st"
-                       : n % 10 == 2        ? "nd"
-                       : n % 10 == 3        ? "rd"
-                                            : "th";
-  return std::to_string(n) + suffix;
-}
-
 // The place next to a corridor's end: the neighbour whose point is nearest that end.
 std::string place_at(const graph::TopologicalMap& map, const graph::Node& n, const Vector2d& end) {
   std::string best;
@@ -91,7 +82,8 @@ std::string describe(const graph::TopologicalMap& map, const graph::Node& n, con
   const auto order = map.lamps_in_walking_order(
       n.id, from_first ? graph::Travel::forward : graph::Travel::backward);
   for (std::size_t i = 0; i < order.size(); ++i)
-    if (order[i]->id == lamp->id) return n.name + ", " + ordinal(int(i) + 1) + " lamp from " + from;
+    if (order[i]->id == lamp->id)
+      return n.name + ", " + graph::ordinal_number(int(i) + 1) + " lamp from " + from;
   return n.name;
 }
 

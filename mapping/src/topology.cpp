@@ -177,14 +177,17 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     add_place(lines[r.line].at(r.s1));
   }
   // Ways out of each place: the runs that go on from it by more than a place's size.
+  // Where a point lies along a run (the distance along its line), if the run passes it.
+  auto along_run = [&](const Run& r, const Vector2d& p) -> std::optional<double> {
+    const Line& L = lines[r.line];
+    const double s = L.along(p);
+    if (L.across(p) < o.same_line_m + 0.5 && s >= r.s0 - near && s <= r.s1 + near) return s;
+    return std::nullopt;
+  };
   auto runs_through = [&](const Place& q) {
     std::vector<std::pair<const Run*, double>> out;
-    for (const auto& r : runs) {
-      const Line& L = lines[r.line];
-      const double s = L.along(q.point);
-      if (L.across(q.point) < o.same_line_m + 0.5 && s >= r.s0 - near && s <= r.s1 + near)
-        out.emplace_back(&r, s);
-    }
+    for (const auto& r : runs)
+      if (const auto s = along_run(r, q.point)) out.emplace_back(&r, *s);
     return out;
   };
   std::vector<Place> kept;
@@ -222,11 +225,8 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
   for (const auto& r : runs) {
     const Line& L = lines[r.line];
     std::vector<std::pair<double, int>> on;
-    for (std::size_t i = 0; i < places.size(); ++i) {
-      const double s = L.along(places[i].point);
-      if (L.across(places[i].point) < o.same_line_m + 0.5 && s >= r.s0 - near && s <= r.s1 + near)
-        on.emplace_back(s, static_cast<int>(i));
-    }
+    for (std::size_t i = 0; i < places.size(); ++i)
+      if (const auto s = along_run(r, places[i].point)) on.emplace_back(*s, static_cast<int>(i));
     std::sort(on.begin(), on.end());
     for (std::size_t k = 1; k < on.size(); ++k) {
       const double len = on[k].first - on[k - 1].first;

@@ -108,8 +108,7 @@ OracleVerdict MapOracle::judge(const std::vector<DriveSample>& drive) const {
         if (std::fabs((pb2 - pb1).norm() - spacing) > o_.tolerance_m) continue;
         const double turn =
             wrap_angle(std::atan2(pb2.y() - pb1.y(), pb2.x() - pb1.x()) - heading_a);
-        if (!alike(a1, b1, turn, o_.tolerance_m) || !alike(a2, *b2, turn, o_.tolerance_m))
-          continue;
+        if (!alike(a1, b1, turn, o_.tolerance_m) || !alike(a2, *b2, turn, o_.tolerance_m)) continue;
         const Pose2 rot(0, 0, turn);
         const Vector2d t = pb1 - rot.transform_from(pa1);
         Twin tw;
@@ -127,7 +126,7 @@ OracleVerdict MapOracle::judge(const std::vector<DriveSample>& drive) const {
   // must match too) until it dies.
   const double inner = o_.view_radius_m - o_.border_m;
   std::size_t alive = twins.size();
-  std::optional<double> last_death = 0.0;
+  double last_death = 0.0;  // travel at which the last twin died (0: none was enumerated)
   for (const DriveSample& s : drive) {
     if (alive == 0) break;
     const std::vector<const Lamp*> truth_view = view(s.pose.translation(), inner);
@@ -158,7 +157,7 @@ OracleVerdict MapOracle::judge(const std::vector<DriveSample>& drive) const {
     }
   }
   out.alive_at_end = alive;
-  if (alive == 0) out.distinguishing_m = twins.empty() ? 0.0 : last_death;
+  if (alive == 0) out.distinguishing_m = last_death;
   return out;
 }
 

@@ -53,6 +53,8 @@ struct RouteCommand {
 
 // "first", "second", ... "tenth", then "11th".
 std::string ordinal_word(int n);
+// "1st", "2nd", "3rd", "4th", ... "11th", "21st".
+std::string ordinal_number(int n);
 
 // Turn angles within this of straight ahead (rad) are not turns: the place is passed.
 constexpr double kStraightTolerance = 35.0 * 3.14159265358979323846 / 180.0;
