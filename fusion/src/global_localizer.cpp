@@ -160,8 +160,19 @@ std::vector<GlobalLocalizer::Impl::BlobRay> GlobalLocalizer::Impl::blob_rays(
   return out;
 }
 
-double GlobalLocalizer::Impl::blob_half_size(const graph::Lamp& l, double range) {
-  return 0.8 * l.length / range;
+double GlobalLocalizer::Impl::blob_half_size(const Pose2& pose, const Tilt& tilt,
+                                             const graph::Lamp& l, const Vector3d& ray) const {
+  // Half the angle the lamp spans along and across itself, as seen from here (a lamp seen
+  // end-on far off-axis spans little; one overhead spans much), and the bloom around it.
+  const Vector3d along(0.5 * l.length * std::cos(l.yaw), 0.5 * l.length * std::sin(l.yaw), 0);
+  const double w = l.width > 0 ? l.width : l.length;
+  const Vector3d across(-0.5 * w * std::sin(l.yaw), 0.5 * w * std::cos(l.yaw), 0);
+  double half = 0;
+  for (const Vector3d& v : {along, across}) {
+    const Vector3d end = camera_point(pose, l.xyz + v, tilt).normalized();
+    half = std::max(half, (end - ray).norm());
+  }
+  return half + kBloom;
 }
 
 GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
@@ -194,9 +205,10 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     const double pos = position_sigma / range, yaw = yaw_sigma * std::sin(theta);
     const double sigma =
         std::sqrt(det * det + tilt_sigma * tilt_sigma + pos * pos + yaw * yaw + face * face);
-    pred.push_back({ray, theta, sigma, blob_half_size(*lamps[i], range), int(i)});
+    pred.push_back({ray, theta, sigma, blob_half_size(pose, tilt, *lamps[i], ray), int(i)});
   }
-  // Lamps whose blobs merge in the image are not expected on their own. Angles between unit
+  // Lamps whose blobs may merge in the image are not expected to match a blob of their own, only
+  // to lie under some blob (a merged blob's centre may fall between them). Angles between unit
   // rays are taken as chords (|a - b| = 2 sin(angle / 2)): within 1 % of the angle below 14
   // degrees, where it matters, and no arc cosine.
   for (std::size_t a = 0; a < pred.size(); ++a)
@@ -238,6 +250,16 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     if (p.crowded || p.theta > expect_theta) continue;
     ++e.expected;
     if (!p.matched) ++e.missing;
+  }
+  for (const Predicted& p : pred) {
+    if (!p.crowded || p.theta > expect_theta) continue;
+    ++e.expected;
+    bool covered = p.matched;
+    for (std::size_t j = 0; j < blobs.size() && !covered; ++j) {
+      const double reach = p.half_size + 3 * p.sigma;
+      covered = (p.ray - blobs[j].ray).squaredNorm() < reach * reach;
+    }
+    if (!covered) ++e.missing;
   }
   for (std::size_t j = 0; j < blobs.size(); ++j)
     if (!b_used[j] && !explained[j]) ++e.unexplained;

@@ -48,8 +48,14 @@ OmniCheck::OmniCheck(const graph::TopologicalMap& map, const CameraDescription& 
   o_.validate();
   if (camera.model != CameraModelKind::pajdla_bakstein)
     throw Error("the omni check needs a pajdla_bakstein camera, '" + camera.name + "' is not");
+  double smallest = 1e9, highest = 0;
   for (const auto& n : map.nodes())
-    for (const auto& l : n.lamps) lamps_.push_back(&l);
+    for (const auto& l : n.lamps) {
+      lamps_.push_back(&l);
+      smallest = std::min({smallest, l.length, l.width > 0 ? l.width : l.length});
+      highest = std::max(highest, l.xyz.z() - (camera.mount.xyz.z()));
+    }
+  if (highest > 0 && smallest < 1e9) min_blob_per_cos_ = 0.25 * smallest / highest;
 }
 
 OmniCheckResult OmniCheck::check(const Pose2& pose, const Eigen::Matrix3d& P,
@@ -95,8 +101,11 @@ OmniCheckResult OmniCheck::check(const Pose2& pose, const Eigen::Matrix3d& P,
     if (!crowded) clear.push_back(p);
   }
   std::vector<const vision::OmniBlob*> used;
+  // Blobs far smaller than any lamp at their angle are spurious lights (a window's glint, a
+  // reflection): they say nothing of where the lamps are.
   for (const auto& b : blobs)
-    if (b.theta <= max_theta + 0.1) used.push_back(&b);
+    if (b.theta <= max_theta + 0.1 && b.angular_radius >= min_blob_per_cos_ * std::cos(b.theta))
+      used.push_back(&b);
   r.blobs = static_cast<int>(used.size());
   r.expected = static_cast<int>(clear.size());
   const bool lamp_side = r.expected >= o_.min_expected, blob_side = r.blobs >= o_.min_expected;

@@ -274,6 +274,44 @@ TEST(GlobalLocalizer, GeneratedBuildingFindsOrSaysAmbiguous) {
   std::cout << found << " of " << views << " views found, " << ambiguous << " ambiguous\n";
 }
 
+// A corner seen from under its lamp, and a crossing put in its place at every heading: the
+// crossing has two rows of lamps the corner has not, seen far off-axis where the rows' lamps
+// crowd each other in the image. Crowded lamps are still expected under some blob: the crossing
+// must lose by those rows, whatever the heading (on a regular building this is what tells a
+// corner from a crossing seen the other way round).
+TEST(GlobalLocalizer, ACrossingCannotPassForACorner) {
+  const Museum m;  // for the robot
+  sim::BuildingOptions bo;
+  bo.nodes = 100;
+  const sim::Building b = sim::generate_building(bo);
+  const graph::TopologicalMap map = graph::parse_map(b.geojson, "generated").map;
+  const graph::Node *corner = nullptr, *crossing = nullptr;
+  for (const auto& n : map.nodes()) {
+    if (!corner && n.place == graph::Place::corner && !n.lamps.empty()) corner = &n;
+    if (!crossing && n.place == graph::Place::junction && map.out_edges(n.id).size() == 4 &&
+        !n.lamps.empty())
+      crossing = &n;
+  }
+  ASSERT_TRUE(corner && crossing);
+  const GlobalLocalizer global(map, m.cam());
+  std::mt19937_64 rng(5);
+  for (int k = 0; k < 4; ++k) {
+    const Pose2 truth(corner->point + Vector2d(0.2, -0.1), 0.3 + k * M_PI / 2);
+    const auto d = render_and_detect(m.cam(), map, truth, rng());
+    const auto at_truth = global.refine(truth, 0.05, 0.02, d);
+    ASSERT_TRUE(at_truth);
+    EXPECT_EQ(at_truth->missing, 0) << "heading " << k;
+    for (int j = 0; j < 4; ++j) {
+      const Pose2 twin(crossing->point + Vector2d(0.2, -0.1), truth.yaw() + j * M_PI / 2);
+      const auto at_twin = global.refine(twin, 0.1, 0.02, d);
+      if (!at_twin) continue;  // nothing matches: no twin at all
+      EXPECT_GE(at_twin->missing, 2) << "heading " << k << ", crossing turned " << j;
+      EXPECT_GE(at_twin->score, at_truth->score + 2 * global.options().pairs.miss_cost - 3.0)
+          << "heading " << k << ", crossing turned " << j;
+    }
+  }
+}
+
 TEST(GlobalLocalizer, HonoursTheCameraMount) {
   Museum m;
   CameraDescription cam = m.cam();

@@ -115,6 +115,10 @@ void kidnaps_on(int nodes, int episodes) {
     if (std::getenv("EPISODE") && k != std::atoi(std::getenv("EPISODE"))) continue;
     rs.push_back(battery.kidnap(1000 + k));
     const auto& r = rs.back();
+    std::cout << "episode " << k << ": fixed " << r.fixed << " after " << r.latency_m
+              << " m, oracle " << (r.oracle_m ? std::to_string(*r.oracle_m) : "undecided")
+              << " m, at most " << r.max_hypotheses << " hypotheses, ambiguous " << r.ambiguous_s
+              << " s, lost " << r.lost_s << " s\n";
     EXPECT_EQ(r.wrong_fixes, 0) << "episode " << k;
     EXPECT_TRUE(r.detected) << "episode " << k;
     EXPECT_TRUE(r.fix_correct) << "episode " << k << ": " << r.last_why;
