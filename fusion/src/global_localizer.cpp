@@ -160,19 +160,17 @@ std::vector<GlobalLocalizer::Impl::BlobRay> GlobalLocalizer::Impl::blob_rays(
   return out;
 }
 
-double GlobalLocalizer::Impl::blob_half_size(const Pose2& pose, const Tilt& tilt,
-                                             const graph::Lamp& l, const Vector3d& ray) const {
-  // Half the angle the lamp spans along and across itself, as seen from here (a lamp seen
-  // end-on far off-axis spans little; one overhead spans much), and the bloom around it.
-  const Vector3d along(0.5 * l.length * std::cos(l.yaw), 0.5 * l.length * std::sin(l.yaw), 0);
+double GlobalLocalizer::Impl::blob_half_size(const graph::Lamp& l, const Vector3d& sight,
+                                             double range) {
+  // Half the angle the lamp spans along and across itself, as seen along `sight` (the unit
+  // vector from the camera to it, in the map): a lamp seen end-on far off-axis spans little,
+  // one overhead much; and the bloom around it.
+  const double c = std::cos(l.yaw), s = std::sin(l.yaw);
+  const double along = c * sight.x() + s * sight.y(), across = -s * sight.x() + c * sight.y();
   const double w = l.width > 0 ? l.width : l.length;
-  const Vector3d across(-0.5 * w * std::sin(l.yaw), 0.5 * w * std::cos(l.yaw), 0);
-  double half = 0;
-  for (const Vector3d& v : {along, across}) {
-    const Vector3d end = camera_point(pose, l.xyz + v, tilt).normalized();
-    half = std::max(half, (end - ray).norm());
-  }
-  return half + kBloom;
+  const double half = 0.5 * std::max(l.length * std::sqrt(std::max(0.0, 1 - along * along)),
+                                     w * std::sqrt(std::max(0.0, 1 - across * across)));
+  return half / range + kBloom;
 }
 
 GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
@@ -194,6 +192,8 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     bool crowded = false, matched = false;
   };
   std::vector<Predicted> pred;
+  const Vector2d mount_xy = pose.transform_from(mount_t.head<2>());
+  const Vector3d camera_at(mount_xy.x(), mount_xy.y(), mount_t.z());
   for (const int i : lamps_in_view(pose, radius)) {
     const Vector3d c = camera_point(pose, lamps[i]->xyz, tilt);
     const double range = c.norm();
@@ -205,7 +205,8 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     const double pos = position_sigma / range, yaw = yaw_sigma * std::sin(theta);
     const double sigma =
         std::sqrt(det * det + tilt_sigma * tilt_sigma + pos * pos + yaw * yaw + face * face);
-    pred.push_back({ray, theta, sigma, blob_half_size(pose, tilt, *lamps[i], ray), int(i)});
+    const Vector3d sight = (lamps[i]->xyz - camera_at) / range;
+    pred.push_back({ray, theta, sigma, blob_half_size(*lamps[i], sight, range), int(i)});
   }
   // Lamps whose blobs may merge in the image are not expected to match a blob of their own, only
   // to lie under some blob (a merged blob's centre may fall between them). Angles between unit

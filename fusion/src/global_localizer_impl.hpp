@@ -129,11 +129,10 @@ struct GlobalLocalizer::Impl {
   // A blob's centroid is not quite the projection of the lamp's centre (the lens bends a near
   // lamp's face unevenly): a tenth of the lamp's angular size (rad).
   static double face_sigma(const graph::Lamp& l, double range) { return 0.1 * l.length / range; }
-  // Half the angular size of a lamp's blob seen from a pose (as a chord of unit rays; the IR
-  // bloom makes it larger than the lamp by kBloom). `ray`: to the lamp's centre.
+  // Half the angular size (rad) of a lamp's blob seen along `sight` (unit, camera to lamp, in
+  // the map) from `range`: the IR bloom makes it larger than the lamp by kBloom.
   static constexpr double kBloom = 0.05;
-  double blob_half_size(const Pose2& pose, const Tilt& tilt, const graph::Lamp& l,
-                        const Vector3d& ray) const;
+  static double blob_half_size(const graph::Lamp& l, const Vector3d& sight, double range);
 
   // Scores a pose known within (position_sigma, yaw_sigma) and a floor tilt known within
   // tilt_sigma: predicted lamps matched one-to-one to blobs, nearest first, within 3 sigma.
