@@ -23,6 +23,7 @@ namespace {
 
 struct BuildArgs {
   std::string log, robot, out, names, initial_pose;
+  io::BagTopics topics;
   double corridor_width = 2.0;
   bool quiet = false;
 };
@@ -48,10 +49,10 @@ int run_build(const BuildArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::vector<mapping::PlaceName> names =
       a.names.empty() ? std::vector<mapping::PlaceName>{} : read_names(a.names);
-  const io::MissionLog log = io::read_mission_log(a.log);
+  RobotDescription robot;
+  const io::MissionLog log = read_log_for_robot(a.log, a.robot, a.topics, robot);
   const double read_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const RobotDescription robot = robot_for_log(log, a.log, a.robot);
   mapping::MapBuildOptions o;
   o.topology.corridor_width_m = a.corridor_width;
   if (!a.initial_pose.empty()) o.start = parse_pose_option(a.initial_pose, "--initial-pose");
@@ -91,14 +92,15 @@ int run_build(const BuildArgs& a) {
 
 struct SurveyArgs {
   std::string map, log, robot, update, initial_pose;
+  io::BagTopics topics;
   bool json = false, quiet = false;
 };
 
 int run_survey(const SurveyArgs& a) {
   const graph::LoadedMap loaded = graph::read_map(a.map);
   for (const auto& w : loaded.warnings) diagnostic("warning", w.text());
-  const io::MissionLog log = io::read_mission_log(a.log);
-  const RobotDescription robot = robot_for_log(log, a.log, a.robot);
+  RobotDescription robot;
+  const io::MissionLog log = read_log_for_robot(a.log, a.robot, a.topics, robot);
   ProgressBar bar(a.quiet || a.json);
   const mapping::DriveLamps drive = mapping::map_drive_lamps(
       log, a.log, robot, {}, [&bar](double f) { bar.update(f, "mapping the drive"); });
@@ -171,7 +173,7 @@ void add_map_survey_command(CLI::App& map, Job& run) {
   CLI::App* survey = map.add_subcommand(
       "survey", "Compare a drive with a map: failed, moved and new lamps, named by place");
   survey->add_option("MAP", args->map, "Map file (.geojson)")->required();
-  survey->add_option("LOG", args->log, "Mission log of the drive (.mcap)")->required();
+  survey->add_option("LOG", args->log, "Mission log or ROS 2 bag of the drive (.mcap)")->required();
   survey->add_option("--robot", args->robot, "robot.json (default: the log's attachment)");
   survey->add_flag("--json", args->json, "Print the findings as JSON");
   survey->add_option("--initial-pose", args->initial_pose,
@@ -181,6 +183,7 @@ void add_map_survey_command(CLI::App& map, Job& run) {
                      "Write the corrected map (moved lamps moved, new ones added, failed ones "
                      "taken out)");
   survey->add_flag("--quiet", args->quiet, "No progress bar");
+  add_bag_topic_options(*survey, args->topics);
   survey->callback([args, &run] { run = [args] { return run_survey(*args); }; });
 }
 
@@ -188,7 +191,7 @@ void add_map_build_command(CLI::App& map, Job& run) {
   auto args = std::make_shared<BuildArgs>();
   CLI::App* build = map.add_subcommand(
       "build", "Build a map (lamps, places, connections) from a drive; never reads the log's map");
-  build->add_option("LOG", args->log, "Mission log of the drive (.mcap)")->required();
+  build->add_option("LOG", args->log, "Mission log or ROS 2 bag of the drive (.mcap)")->required();
   build->add_option("--robot", args->robot, "robot.json (default: the log's attachment)");
   build->add_option("-o,--output", args->out, "Map to write (.geojson)")->required();
   build->add_option("--names", args->names,
@@ -200,6 +203,7 @@ void add_map_build_command(CLI::App& map, Job& run) {
                     "X,Y,YAW: where the drive started, in the frame the map should have (m, m, "
                     "rad); default: the start is the origin, facing x");
   build->add_flag("--quiet", args->quiet, "No progress bar");
+  add_bag_topic_options(*build, args->topics);
   build->callback([args, &run] { run = [args] { return run_build(*args); }; });
 }
 

@@ -178,6 +178,7 @@ int run_mission(const RunArgs& a) {
 
 struct ReplayArgs {
   std::string log, map, robot, initial_pose, out = "lampnav-out";
+  io::BagTopics topics;
   bool no_ceiling = false, no_omni = false, quiet = false;
 };
 
@@ -185,7 +186,9 @@ int run_replay(const ReplayArgs& a) {
   std::optional<Pose2> initial;
   if (!a.initial_pose.empty()) initial = parse_pose_option(a.initial_pose, "--initial-pose");
   if (!fs::exists(a.log)) throw InputError({a.log, "", ""}, "no such file");
-  const io::MissionLog log = io::read_mission_log(a.log);
+  RobotDescription robot;
+  std::string robot_json;
+  const io::MissionLog log = read_log_for_robot(a.log, a.robot, a.topics, robot, &robot_json);
   std::string map_text, map_source;
   if (!a.map.empty()) {
     map_text = json::read_file(a.map);
@@ -197,8 +200,6 @@ int run_replay(const ReplayArgs& a) {
     throw InputError({a.log, "attachments", "map.geojson"}, "the log has no map: give --map");
   }
   const graph::LoadedMap loaded = graph::parse_map(map_text, map_source);
-  std::string robot_json;
-  const RobotDescription robot = robot_for_log(log, a.log, a.robot, &robot_json);
   navigation::ReplayOptions o;
   o.use_ceiling = !a.no_ceiling;
   o.use_omni = !a.no_omni;
@@ -240,7 +241,7 @@ void add_run_commands(CLI::App& app, Job& run) {
       "replay",
       "Run the stack over a recorded mission; write replay.mcap, TUM trajectories, "
       "metrics.json and report.html");
-  pc->add_option("LOG", pa->log, "Mission log (.mcap)")->required();
+  pc->add_option("LOG", pa->log, "Mission log or ROS 2 bag (.mcap)")->required();
   pc->add_option("--map", pa->map, "Map (.geojson); default the log's attachment");
   pc->add_option("--robot", pa->robot, "robot.json; default the log's attachment");
   pc->add_option("--initial-pose", pa->initial_pose,
@@ -249,6 +250,7 @@ void add_run_commands(CLI::App& app, Job& run) {
   pc->add_flag("--no-ceiling", pa->no_ceiling, "Leave the ceiling camera's frames out");
   pc->add_flag("--no-omni", pa->no_omni, "Leave the omni camera's frames out");
   pc->add_flag("-q,--quiet", pa->quiet, "No progress bar");
+  add_bag_topic_options(*pc, pa->topics);
   pc->callback([pa, &run] { run = [pa] { return run_replay(*pa); }; });
 }
 

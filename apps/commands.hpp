@@ -16,7 +16,8 @@ class App;
 
 namespace lampnav::io {
 struct MissionLog;
-}
+struct BagTopics;
+}  // namespace lampnav::io
 
 namespace lampnav::apps {
 
@@ -49,6 +50,14 @@ class ProgressBar {
 // attachment; InputError naming the log otherwise. `text`, when given, receives the JSON read.
 RobotDescription robot_for_log(const io::MissionLog& log, const std::string& log_path,
                                const std::string& robot_path, std::string* text = nullptr);
+
+// --ceiling-topic, --omni-topic and --odometry-topic: which topics of a ROS 2 bag are the inputs.
+void add_bag_topic_options(CLI::App& command, io::BagTopics& topics);
+// A mission log or ROS 2 bag and the robot for it (robot_for_log). A bag's odometry becomes the
+// wheel travel of the robot's semi-axis, and how its topics were taken is said on stderr.
+io::MissionLog read_log_for_robot(const std::string& log_path, const std::string& robot_path,
+                                  const io::BagTopics& topics, RobotDescription& robot,
+                                  std::string* robot_text = nullptr);
 
 // X,Y,YAW (m, m, rad) from a command-line option; InputError naming `flag` otherwise.
 Pose2 parse_pose_option(const std::string& text, const std::string& flag);

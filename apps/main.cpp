@@ -66,6 +66,30 @@ RobotDescription robot_for_log(const io::MissionLog& log, const std::string& log
   return robot;
 }
 
+void add_bag_topic_options(CLI::App& command, io::BagTopics& topics) {
+  command.add_option(
+      "--ceiling-topic", topics.ceiling_image,
+      "ROS 2 bag: the ceiling camera's image topic (default: the one named ceiling)");
+  command.add_option("--omni-topic", topics.omni_image,
+                     "ROS 2 bag: the omni camera's image topic (default: the one named omni or "
+                     "fisheye)");
+  command.add_option(
+      "--odometry-topic", topics.odometry,
+      "ROS 2 bag: the nav_msgs/msg/Odometry topic (default: the only one, or /odom)");
+}
+
+io::MissionLog read_log_for_robot(const std::string& log_path, const std::string& robot_path,
+                                  const io::BagTopics& topics, RobotDescription& robot,
+                                  std::string* robot_text) {
+  io::MissionLog log = io::read_mission_log(log_path, topics);
+  robot = robot_for_log(log, log_path, robot_path, robot_text);
+  if (log.ros2_bag) {
+    for (const auto& n : log.notes) diagnostic("note", log_path + ": " + n);
+    io::wheels_from_odometry(log, robot.semi_axis);
+  }
+  return log;
+}
+
 ProgressBar::ProgressBar(bool quiet) : show_(!quiet && ::isatty(2)) {}
 
 void ProgressBar::update(double fraction, const std::string& what) {

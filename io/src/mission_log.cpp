@@ -1,6 +1,7 @@
 #include "lampnav/io/mission_log.hpp"
 
 #include "foxglove_schemas.hpp"
+#include "ros2_bag.hpp"
 
 #include <algorithm>
 #include <array>
@@ -416,7 +417,7 @@ ImageFrame image(const Json& j) {
 
 }  // namespace
 
-MissionLog read_mission_log(const std::string& path) {
+MissionLog read_mission_log(const std::string& path, const BagTopics& bag_topics) {
   McapFile f = read_mcap(path);
   MissionLog log;
   log.report = f.report;
@@ -519,6 +520,9 @@ MissionLog read_mission_log(const std::string& path) {
         break;
     }
   }
+  const bool bag = std::any_of(f.channels.begin(), f.channels.end(),
+                               [](const McapChannel& c) { return c.message_encoding == "cdr"; });
+  if (bag) read_ros2_messages(f, path, bag_topics, log);
   return log;
 }
 

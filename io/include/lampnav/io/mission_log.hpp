@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -168,8 +169,33 @@ class MissionLogWriter {
   std::unique_ptr<Impl> impl_;
 };
 
+// Which topics of a ROS 2 bag are the inputs (mission-log.md, "ROS 2 bags"). An empty one is
+// guessed from the topic names and message types, and the guess said in MissionLog::notes.
+struct BagTopics {
+  std::string ceiling_image, omni_image, odometry;
+};
+
+// nav_msgs/msg/Odometry's pose: the robot base in its odometry frame.
+struct OdometryPose {
+  Stamp stamp;
+  Pose2 pose;
+};
+
+// sensor_msgs/msg/CameraInfo, as the bag gave it.
+struct CameraInfo {
+  Stamp stamp;
+  std::string frame_id;
+  int width = 0, height = 0;
+  std::string distortion_model;  // "plumb_bob", "rational_polynomial", "equidistant", ...
+  std::vector<double> d;
+  std::array<double, 9> k{};
+  std::array<double, 12> p{};
+};
+
 struct MissionLog {
   std::vector<Logged<WheelReading>> wheels;
+  std::vector<Logged<OdometryPose>> odometry;     // a ROS 2 bag's (see wheels_from_odometry)
+  std::map<std::string, CameraInfo> camera_info;  // by topic, the last of each
   std::vector<Logged<ImageFrame>> ceiling_images, omni_images;
   std::vector<Logged<TruthPose>> truth;
   std::vector<Logged<MissionEvent>> events;
@@ -178,11 +204,21 @@ struct MissionLog {
   McapReadReport report;              // container-level findings (truncation, skipped records)
   std::size_t skipped_messages = 0;   // messages refused for their content (bad JSON, base64, ...)
   std::vector<std::string> problems;  // one line per skipped message, naming topic and sequence
+  bool ros2_bag = false;              // CDR messages were read (a ROS 2 bag)
+  std::vector<std::string> notes;     // how the bag's topics were taken
 };
 
-// Reads a mission log. Throws InputError for a file that is not MCAP at all; damaged content is
-// skipped, counted and reported in the result.
-MissionLog read_mission_log(const std::string& path);
+// Reads a mission log, or a ROS 2 bag in MCAP (schema encoding ros2msg, message encoding cdr):
+// sensor_msgs/msg/CompressedImage and Image (mono8, mono16, bgr8, rgb8, bgra8, rgba8; any step),
+// nav_msgs/msg/Odometry, sensor_msgs/msg/CameraInfo. Throws InputError for a file that is not
+// MCAP at all, and for a bag whose topics cannot be told apart (the message lists them); damaged
+// content is skipped, counted and reported in the result.
+MissionLog read_mission_log(const std::string& path, const BagTopics& topics = {});
+
+// A bag's odometry as the wheel travel lampnav reads (conventions.md): each step of the odometry
+// pose, split between the two wheels of a differential drive with this semi-axis (m). Nothing is
+// done when the log has wheel readings of its own.
+void wheels_from_odometry(MissionLog& log, double semi_axis);
 
 // The truth of a log at any instant, interpolated between the samples around it. A kidnap is a
 // jump between two samples (more than 0.5 m): no interpolation across it.

@@ -1,0 +1,348 @@
+#include "ros2_bag.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <sstream>
+#include <thread>
+
+#include "cdr.hpp"
+#include "lampnav/core/error.hpp"
+
+namespace lampnav::io {
+
+namespace {
+
+// "sensor_msgs/msg/Image" and the older "sensor_msgs/Image" name the same type.
+std::string type_of(const McapFile& f, const McapChannel& ch) {
+  const McapSchema* s = f.schema(ch.schema_id);
+  if (!s) return {};
+  std::string name = s->name;
+  if (const auto p = name.find("/msg/"); p != std::string::npos) name.erase(p, 4);
+  return name;
+}
+
+bool is_image(const std::string& type) {
+  return type == "sensor_msgs/CompressedImage" || type == "sensor_msgs/Image";
+}
+
+struct Header {
+  Stamp stamp;
+  std::string frame_id;
+};
+
+Header header(CdrReader& r) {
+  Header h;
+  const std::int32_t sec = r.i32("header.stamp.sec");
+  const std::uint32_t nsec = r.u32("header.stamp.nanosec");
+  if (nsec >= 1'000'000'000u) throw CdrError("header.stamp.nanosec is not below 1e9");
+  if (sec < 0) throw CdrError("header.stamp.sec is negative");
+  h.stamp = stamp_from_nanoseconds(std::int64_t(sec) * 1'000'000'000 + nsec);
+  h.frame_id = r.string("header.frame_id");
+  return h;
+}
+
+// sensor_msgs/msg/CompressedImage: the bytes as they are (PNG or JPEG, told by their magic, not
+// by the free-text `format`).
+ImageFrame compressed_image(const std::string& data) {
+  CdrReader r(data);
+  ImageFrame f;
+  const Header h = header(r);
+  f.stamp = h.stamp;
+  f.frame_id = h.frame_id;
+  const std::string format = r.string("format");
+  f.data = r.bytes("data");
+  const auto* b = reinterpret_cast<const unsigned char*>(f.data.data());
+  if (f.data.size() >= 8 && b[0] == 0x89 && b[1] == 'P' && b[2] == 'N' && b[3] == 'G')
+    f.format = "png";
+  else if (f.data.size() >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF)
+    f.format = "jpeg";
+  else
+    throw CdrError("data is neither PNG nor JPEG (format \"" + format + "\")");
+  return f;
+}
+
+// sensor_msgs/msg/Image: grey from the supported encodings, kept as a fast PNG.
+ImageFrame raw_image(const std::string& data) {
+  CdrReader r(data);
+  ImageFrame f;
+  const Header h = header(r);
+  f.stamp = h.stamp;
+  f.frame_id = h.frame_id;
+  const std::uint32_t height = r.u32("height"), width = r.u32("width");
+  const std::string encoding = r.string("encoding");
+  const bool big_endian = r.u8("is_bigendian") != 0;
+  const std::uint32_t step = r.u32("step");
+  const std::string pixels = r.bytes("data");
+  int channels = 0, depth = 1;
+  if (encoding == "mono8" || encoding == "8UC1")
+    channels = 1;
+  else if (encoding == "mono16" || encoding == "16UC1")
+    channels = 1, depth = 2;
+  else if (encoding == "bgr8" || encoding == "rgb8" || encoding == "8UC3")
+    channels = 3;
+  else if (encoding == "bgra8" || encoding == "rgba8" || encoding == "8UC4")
+    channels = 4;
+  else
+    throw CdrError("encoding \"" + encoding +
+                   "\" is not read (mono8, mono16, bgr8, rgb8, bgra8, rgba8)");
+  if (width == 0 || height == 0 || width > 16384 || height > 16384)
+    throw CdrError("image size " + std::to_string(width) + " x " + std::to_string(height) +
+                   " is out of range");
+  const std::uint64_t row = std::uint64_t(width) * channels * depth;
+  if (step < row)
+    throw CdrError("step " + std::to_string(step) + " is shorter than a row (" +
+                   std::to_string(row) + " bytes)");
+  if (std::uint64_t(step) * height > pixels.size())
+    throw CdrError("data holds " + std::to_string(pixels.size()) + " bytes, step x height is " +
+                   std::to_string(std::uint64_t(step) * height));
+  Image8 grey(static_cast<int>(width), static_cast<int>(height));
+  for (std::uint32_t y = 0; y < height; ++y) {
+    const auto* in = reinterpret_cast<const unsigned char*>(pixels.data()) + std::size_t(y) * step;
+    std::uint8_t* out = &grey.pixels[std::size_t(y) * width];
+    for (std::uint32_t x = 0; x < width; ++x) {
+      const unsigned char* p = in + std::size_t(x) * channels * depth;
+      if (depth == 2) {
+        const unsigned v = big_endian ? (p[0] << 8 | p[1]) : (p[1] << 8 | p[0]);
+        out[x] = static_cast<std::uint8_t>(v >> 8);
+      } else if (channels == 1) {
+        out[x] = p[0];
+      } else {
+        // ITU-R 601 luma, as OpenCV's colour conversion.
+        const bool rgb = encoding[0] == 'r';
+        const double b = rgb ? p[2] : p[0], g = p[1], rr = rgb ? p[0] : p[2];
+        out[x] = static_cast<std::uint8_t>(std::lround(0.114 * b + 0.587 * g + 0.299 * rr));
+      }
+    }
+  }
+  f.format = "png";
+  f.data = encode_png(grey, 1);
+  return f;
+}
+
+OdometryPose odometry(const std::string& data) {
+  CdrReader r(data);
+  OdometryPose o;
+  o.stamp = header(r).stamp;
+  r.string("child_frame_id");
+  const double x = r.f64("pose.pose.position.x"), y = r.f64("pose.pose.position.y");
+  r.f64("pose.pose.position.z");
+  const double qx = r.f64("pose.pose.orientation.x"), qy = r.f64("pose.pose.orientation.y"),
+               qz = r.f64("pose.pose.orientation.z"), qw = r.f64("pose.pose.orientation.w");
+  for (int k = 0; k < 36; ++k) r.f64("pose.covariance");
+  for (int k = 0; k < 6 + 36; ++k) r.f64("twist");
+  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(qx + qy + qz + qw))
+    throw CdrError("pose is not finite");
+  const double yaw = std::atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz));
+  o.pose = Pose2(x, y, yaw);
+  return o;
+}
+
+CameraInfo camera_info(const std::string& data) {
+  CdrReader r(data);
+  CameraInfo c;
+  const Header h = header(r);
+  c.stamp = h.stamp;
+  c.frame_id = h.frame_id;
+  c.height = static_cast<int>(r.u32("height"));
+  c.width = static_cast<int>(r.u32("width"));
+  c.distortion_model = r.string("distortion_model");
+  c.d = r.f64s("d");
+  for (auto& v : c.k) v = r.f64("k");
+  for (int k = 0; k < 9; ++k) r.f64("r");
+  for (auto& v : c.p) v = r.f64("p");
+  return c;
+}
+
+std::string topic_list(const McapFile& f, const std::vector<std::size_t>& counts) {
+  std::ostringstream s;
+  bool first = true;
+  for (const auto& ch : f.channels) {
+    s << (first ? "" : ", ") << ch.topic << " (" << type_of(f, ch) << ", "
+      << counts[&ch - f.channels.data()] << " messages)";
+    first = false;
+  }
+  return s.str();
+}
+
+}  // namespace
+
+void read_ros2_messages(const McapFile& f, const std::string& path, const BagTopics& wanted,
+                        MissionLog& log) {
+  std::vector<std::size_t> counts(f.channels.size(), 0);
+  std::map<std::uint16_t, std::size_t> index;
+  for (std::size_t k = 0; k < f.channels.size(); ++k) index[f.channels[k].id] = k;
+  for (const auto& m : f.messages)
+    if (const auto it = index.find(m.channel_id); it != index.end()) ++counts[it->second];
+  auto fail = [&](const std::string& field, const std::string& what) {
+    throw InputError({path, "topics", field}, what + "; the bag has: " + topic_list(f, counts));
+  };
+  auto cdr = [](const McapChannel& ch) { return ch.message_encoding == "cdr"; };
+  // The channel of a topic given by name: it must be there, with a type that fits.
+  auto named = [&](const std::string& topic, const char* field, auto fits) -> const McapChannel* {
+    const McapChannel* ch = f.channel(topic);
+    if (!ch || !cdr(*ch)) fail(field, "no CDR topic \"" + topic + "\"");
+    if (!fits(type_of(f, *ch)))
+      fail(field, "\"" + topic + "\" is a " + type_of(f, *ch) + ", not what " + field + " needs");
+    return ch;
+  };
+  // Guessed: the image topics whose name says the camera, a compressed one before a raw one.
+  auto guess_camera = [&](std::initializer_list<const char*> words) -> const McapChannel* {
+    std::vector<const McapChannel*> found;
+    for (const auto& ch : f.channels) {
+      if (!cdr(ch) || !is_image(type_of(f, ch))) continue;
+      std::string t = ch.topic;
+      std::transform(t.begin(), t.end(), t.begin(),
+                     [](unsigned char c) { return std::tolower(c); });
+      for (const char* w : words)
+        if (t.find(w) != std::string::npos) {
+          found.push_back(&ch);
+          break;
+        }
+    }
+    const auto compressed = std::count_if(found.begin(), found.end(), [&](const McapChannel* c) {
+      return type_of(f, *c) == "sensor_msgs/CompressedImage";
+    });
+    if (compressed >= 1)
+      found.erase(std::remove_if(found.begin(), found.end(),
+                                 [&](const McapChannel* c) {
+                                   return type_of(f, *c) != "sensor_msgs/CompressedImage";
+                                 }),
+                  found.end());
+    return found.size() == 1 ? found.front() : nullptr;
+  };
+
+  const McapChannel *ceiling = nullptr, *omni = nullptr, *odom = nullptr;
+  if (!wanted.ceiling_image.empty())
+    ceiling = named(wanted.ceiling_image, "ceiling camera topic", is_image);
+  else if ((ceiling = guess_camera({"ceiling"})))
+    log.notes.push_back("ceiling camera images from " + ceiling->topic + " (by its name)");
+  if (!wanted.omni_image.empty())
+    omni = named(wanted.omni_image, "omni camera topic", is_image);
+  else if ((omni = guess_camera({"omni", "fisheye", "panoram", "360"})))
+    log.notes.push_back("omni camera images from " + omni->topic + " (by its name)");
+  auto is_odometry = [](const std::string& t) { return t == "nav_msgs/Odometry"; };
+  if (!wanted.odometry.empty()) {
+    odom = named(wanted.odometry, "odometry topic", is_odometry);
+  } else {
+    std::vector<const McapChannel*> all;
+    for (const auto& ch : f.channels)
+      if (cdr(ch) && is_odometry(type_of(f, ch))) all.push_back(&ch);
+    if (all.size() == 1) odom = all.front();
+    for (const auto* c : all)
+      if (all.size() > 1 && (c->topic == "/odom" || c->topic == "odom")) odom = c;
+    if (odom)
+      log.notes.push_back("wheel odometry from " + odom->topic);
+    else if (all.size() > 1)
+      fail("odometry topic",
+           "several nav_msgs/msg/Odometry topics; name one with --odometry-topic");
+  }
+  bool images = false;
+  for (const auto& ch : f.channels) images = images || (cdr(ch) && is_image(type_of(f, ch)));
+  if (images && !ceiling && !omni)
+    fail("camera topics",
+         "cannot tell which image topic is which camera (no name says \"ceiling\", \"omni\" or "
+         "\"fisheye\"); name them with --ceiling-topic and --omni-topic");
+  if (ceiling && omni && ceiling == omni)
+    fail("camera topics", "the ceiling and omni cameras cannot both be " + ceiling->topic);
+  if (!odom) log.notes.push_back("no nav_msgs/msg/Odometry topic: the bag gives no wheel odometry");
+
+  // Decoded on every core, kept in file order.
+  struct Decoded {
+    enum Kind { none, ceiling, omni, odometry, info, bad } kind = none;
+    Logged<ImageFrame> image;
+    Logged<OdometryPose> odo;
+    CameraInfo info_value;
+    std::string topic, problem;
+  };
+  std::vector<Decoded> decoded(f.messages.size());
+  auto decode = [&](std::size_t i) {
+    const McapMessage& m = f.messages[i];
+    const McapChannel* ch = f.channel(m.channel_id);
+    if (!ch || !cdr(*ch)) return;
+    Decoded& d = decoded[i];
+    const Stamp avail = stamp_from_nanoseconds(static_cast<std::int64_t>(m.log_time));
+    const std::string type = type_of(f, *ch);
+    try {
+      if (ch == ceiling || ch == omni) {
+        d.image = {avail,
+                   type == "sensor_msgs/Image" ? raw_image(m.data) : compressed_image(m.data)};
+        if (d.image.value.frame_id.empty())
+          d.image.value.frame_id = ch == ceiling ? "ceiling_camera" : "omni_camera";
+        d.kind = ch == ceiling ? Decoded::ceiling : Decoded::omni;
+      } else if (ch == odom) {
+        d.odo = {avail, odometry(m.data)};
+        d.kind = Decoded::odometry;
+      } else if (type == "sensor_msgs/CameraInfo") {
+        d.info_value = camera_info(m.data);
+        d.topic = ch->topic;
+        d.kind = Decoded::info;
+      }
+    } catch (const CdrError& e) {
+      d.kind = Decoded::bad;
+      d.problem = ch->topic + " message " + std::to_string(m.sequence) + " (" + type +
+                  "): " + e.what() + " (skipped)";
+    } catch (const InputError& e) {
+      d.kind = Decoded::bad;
+      d.problem =
+          ch->topic + " message " + std::to_string(m.sequence) + ": " + e.what() + " (skipped)";
+    }
+  };
+  {
+    std::atomic<std::size_t> next{0};
+    auto work = [&] {
+      for (std::size_t i = next++; i < decoded.size(); i = next++) decode(i);
+    };
+    const unsigned n = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
+    std::vector<std::thread> pool;
+    for (unsigned k = 1; k < n && decoded.size() > 64; ++k) pool.emplace_back(work);
+    work();
+    for (auto& t : pool) t.join();
+  }
+  log.ros2_bag = true;
+  for (auto& d : decoded) {
+    switch (d.kind) {
+      case Decoded::ceiling:
+        log.ceiling_images.push_back(std::move(d.image));
+        break;
+      case Decoded::omni:
+        log.omni_images.push_back(std::move(d.image));
+        break;
+      case Decoded::odometry:
+        log.odometry.push_back(std::move(d.odo));
+        break;
+      case Decoded::info:
+        log.camera_info[d.topic] = std::move(d.info_value);
+        break;
+      case Decoded::bad:
+        ++log.skipped_messages;
+        log.problems.push_back(std::move(d.problem));
+        break;
+      case Decoded::none:
+        break;
+    }
+  }
+}
+
+void wheels_from_odometry(MissionLog& log, double semi_axis) {
+  if (!log.wheels.empty() || log.odometry.size() < 2) return;
+  auto odo = log.odometry;
+  std::stable_sort(odo.begin(), odo.end(),
+                   [](const auto& a, const auto& b) { return a.value.stamp < b.value.stamp; });
+  double left = 0, right = 0;
+  log.wheels.push_back({odo.front().log_time, {odo.front().value.stamp, 0.0, 0.0}});
+  for (std::size_t k = 1; k < odo.size(); ++k) {
+    if (!(odo[k].value.stamp > odo[k - 1].value.stamp)) continue;
+    const Pose2 step = odo[k - 1].value.pose.between(odo[k].value.pose);
+    // A differential drive moves along its heading: the chord of the step (forwards or
+    // backwards), and its turn. The chord is the travel for odometry integrated by the midpoint
+    // rule (ROS's diff_drive_controller), and within ds dyaw^2 / 24 of it for exact arcs.
+    const double dyaw = step.yaw();
+    const double ds = std::copysign(step.translation().norm(), step.x());
+    left += ds - semi_axis * dyaw;
+    right += ds + semi_axis * dyaw;
+    log.wheels.push_back({odo[k].log_time, {odo[k].value.stamp, left, right}});
+  }
+}
+
+}  // namespace lampnav::io

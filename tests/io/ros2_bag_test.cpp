@@ -1,0 +1,293 @@
+// ROS 2 bags in MCAP: CDR decoding against bytes written by hand from the published encoding
+// (both byte orders, alignment, strings, sequences), the message types lampnav reads, which topic
+// is which camera, and a clear word for what cannot be read.
+
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "cdr_writer.hpp"
+#include "lampnav/core/error.hpp"
+#include "lampnav/io/mcap.hpp"
+#include "lampnav/io/mission_log.hpp"
+#include "lampnav_test.hpp"
+
+namespace lampnav::io {
+namespace {
+
+using test::CdrWriter;
+using ::testing::HasSubstr;
+
+std::string temp_file(const std::string& name) {
+  return (std::filesystem::temp_directory_path() /
+          ("lampnav_bag_" + std::to_string(::getpid()) + "_" + name))
+      .string();
+}
+
+// A bag: topics (name, type) and messages (topic index, log time ns, CDR bytes).
+struct Bag {
+  std::vector<std::pair<std::string, std::string>> topics;
+  struct Message {
+    int topic;
+    std::uint64_t log_time;
+    std::string data;
+  };
+  std::vector<Message> messages;
+  std::string write(const std::string& name) const {
+    const std::string path = temp_file(name);
+    McapWriter w(path, {"ros2"});
+    std::vector<std::uint16_t> channels;
+    for (const auto& [topic, type] : topics) {
+      const auto s = w.add_schema(type, "ros2msg", "# " + type + "\n");
+      channels.push_back(w.add_channel(s, topic, "cdr"));
+    }
+    for (const auto& m : messages) w.write(channels[m.topic], m.log_time, m.log_time, m.data);
+    w.close();
+    return path;
+  }
+};
+
+Image8 gradient(int w, int h) {
+  Image8 img(w, h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      img.pixels[y * w + x] = static_cast<std::uint8_t>((x * 7 + y * 3) % 256);
+  return img;
+}
+
+// sensor_msgs/msg/Image with `encoding`, each grey pixel written as that encoding holds it, rows
+// padded to `step`.
+std::string raw_image_cdr(const Image8& g, const std::string& encoding, std::uint32_t step,
+                          bool little, bool big_endian_pixels = false) {
+  const int channels = encoding == "mono8" || encoding == "mono16" ? 1
+                       : encoding == "bgra8"                       ? 4
+                                                                   : 3;
+  const int depth = encoding == "mono16" ? 2 : 1;
+  std::string data(std::size_t(step) * g.height, '\x55');
+  for (int y = 0; y < g.height; ++y)
+    for (int x = 0; x < g.width; ++x) {
+      const std::uint8_t v = g.pixels[y * g.width + x];
+      char* p = &data[std::size_t(y) * step + std::size_t(x) * channels * depth];
+      if (depth == 2) {
+        const std::uint16_t w16 = static_cast<std::uint16_t>(v * 257);
+        p[big_endian_pixels ? 0 : 1] = static_cast<char>(w16 >> 8);
+        p[big_endian_pixels ? 1 : 0] = static_cast<char>(w16 & 0xFF);
+      } else {
+        for (int c = 0; c < std::min(channels, 3); ++c) p[c] = static_cast<char>(v);
+        if (channels == 4) p[3] = '\xFF';
+      }
+    }
+  return CdrWriter(little)
+      .header(5'000'000'000, "cam")
+      .u32(static_cast<std::uint32_t>(g.height))
+      .u32(static_cast<std::uint32_t>(g.width))
+      .string(encoding)
+      .u8(big_endian_pixels ? 1 : 0)
+      .u32(step)
+      .bytes(data)
+      .data();
+}
+
+TEST(Ros2Bag, ImagesOdometryAndCalibrationInBothByteOrders) {
+  const Image8 g = gradient(37, 21);
+  const std::string png = encode_png(g);
+  Bag bag;
+  bag.topics = {{"/ceiling_camera/image/compressed", "sensor_msgs/msg/CompressedImage"},
+                {"/omni/image_raw", "sensor_msgs/msg/Image"},
+                {"/odom", "nav_msgs/msg/Odometry"},
+                {"/omni/camera_info", "sensor_msgs/msg/CameraInfo"}};
+  bag.messages.push_back(
+      {0, 2'100'000'000, test::compressed_image_cdr(2'000'000'000, "ceiling", "png", png, true)});
+  bag.messages.push_back(
+      {0, 2'200'000'000, test::compressed_image_cdr(2'100'000'000, "ceiling", "png", png, false)});
+  bag.messages.push_back({1, 5'100'000'000, raw_image_cdr(g, "mono8", 40, true)});
+  bag.messages.push_back({1, 5'200'000'000, raw_image_cdr(g, "bgr8", 37 * 3 + 5, false)});
+  bag.messages.push_back({1, 5'300'000'000, raw_image_cdr(g, "mono16", 80, true, true)});
+  bag.messages.push_back({1, 5'400'000'000, raw_image_cdr(g, "bgra8", 37 * 4, true)});
+  bag.messages.push_back({2, 1'010'000'000, test::odometry_cdr(1'000'000'000, 1.0, 2.0, 0.3)});
+  bag.messages.push_back(
+      {2, 1'030'000'000, test::odometry_cdr(1'020'000'000, 1.5, 2.25, -3.0, false)});
+  CdrWriter info(true);
+  info.header(1'000'000'000, "omni").u32(480).u32(640).string("equidistant");
+  info.f64s({0.1, -0.02, 0.003, 0.0004});
+  for (int k = 0; k < 9; ++k) info.f64(k + 1);
+  for (int k = 0; k < 9; ++k) info.f64(k == 0 || k == 4 || k == 8);
+  for (int k = 0; k < 12; ++k) info.f64(10 + k);
+  info.u32(0).u32(0).u32(0).u32(0).u32(0).u32(0).u8(0);
+  bag.messages.push_back({3, 1'000'000'000, info.data()});
+  const std::string path = bag.write("all.mcap");
+  const MissionLog log = read_mission_log(path);
+  std::filesystem::remove(path);
+
+  EXPECT_TRUE(log.ros2_bag);
+  EXPECT_EQ(log.skipped_messages, 0u) << (log.problems.empty() ? "" : log.problems.front());
+  ASSERT_EQ(log.ceiling_images.size(), 2u);
+  EXPECT_EQ(log.ceiling_images[0].value.stamp, stamp_from_nanoseconds(2'000'000'000));
+  EXPECT_EQ(log.ceiling_images[0].log_time, stamp_from_nanoseconds(2'100'000'000));
+  EXPECT_EQ(log.ceiling_images[1].value.format, "png");
+  EXPECT_EQ(log.ceiling_images[1].value.data, png);
+  ASSERT_EQ(log.omni_images.size(), 4u);
+  for (const auto& f : log.omni_images) {
+    const Image8 back = decode_image(f.value.data, "omni");
+    EXPECT_EQ(back.width, g.width);
+    EXPECT_EQ(back.pixels, g.pixels);
+  }
+  ASSERT_EQ(log.odometry.size(), 2u);
+  EXPECT_NEAR(log.odometry[0].value.pose.x(), 1.0, 1e-12);
+  EXPECT_NEAR(log.odometry[0].value.pose.yaw(), 0.3, 1e-12);
+  EXPECT_NEAR(log.odometry[1].value.pose.y(), 2.25, 1e-12);
+  EXPECT_NEAR(log.odometry[1].value.pose.yaw(), -3.0, 1e-12);
+  ASSERT_EQ(log.camera_info.count("/omni/camera_info"), 1u);
+  const CameraInfo& ci = log.camera_info.at("/omni/camera_info");
+  EXPECT_EQ(ci.width, 640);
+  EXPECT_EQ(ci.height, 480);
+  EXPECT_EQ(ci.distortion_model, "equidistant");
+  EXPECT_EQ(ci.d.size(), 4u);
+  EXPECT_EQ(ci.k[8], 9.0);
+  EXPECT_EQ(ci.p[11], 21.0);
+  // How the topics were taken is said.
+  std::string notes;
+  for (const auto& n : log.notes) notes += n + "\n";
+  EXPECT_THAT(notes, HasSubstr("/ceiling_camera/image/compressed"));
+  EXPECT_THAT(notes, HasSubstr("/omni/image_raw"));
+  EXPECT_THAT(notes, HasSubstr("/odom"));
+}
+
+// A differential drive's odometry, split back into the travel of its two wheels.
+TEST(Ros2Bag, OdometryBecomesWheelTravel) {
+  MissionLog log;
+  const double b = 0.2;
+  Pose2 p(3, -1, 0.5);
+  double left = 0, right = 0;
+  std::vector<std::pair<double, double>> expected;
+  for (int k = 0; k < 50; ++k) {
+    log.odometry.push_back(
+        {stamp_from_nanoseconds(k * 20'000'000), {stamp_from_nanoseconds(k * 20'000'000), p}});
+    expected.push_back({left, right});
+    const double dl = 0.01 + 0.002 * std::sin(k), dr = 0.012 - 0.001 * k / 50.0;
+    left += dl;
+    right += dr;
+    const double ds = 0.5 * (dl + dr), dyaw = (dr - dl) / (2 * b);
+    // The midpoint rule, as ROS's diff_drive_controller integrates.
+    p = Pose2(p.x() + ds * std::cos(p.yaw() + dyaw / 2), p.y() + ds * std::sin(p.yaw() + dyaw / 2),
+              wrap_angle(p.yaw() + dyaw));
+  }
+  wheels_from_odometry(log, b);
+  ASSERT_EQ(log.wheels.size(), log.odometry.size());
+  for (std::size_t k = 0; k < log.wheels.size(); ++k) {
+    EXPECT_NEAR(log.wheels[k].value.left, expected[k].first, 1e-9) << k;
+    EXPECT_NEAR(log.wheels[k].value.right, expected[k].second, 1e-9) << k;
+  }
+  // A log with wheel readings of its own keeps them.
+  const auto before = log.wheels;
+  wheels_from_odometry(log, 0.3);
+  EXPECT_EQ(log.wheels.size(), before.size());
+}
+
+TEST(Ros2Bag, TopicsNamedOrGuessedOrRefusedWithTheList) {
+  const std::string png = encode_png(gradient(8, 8));
+  Bag bag;
+  bag.topics = {{"/cam0/image", "sensor_msgs/msg/CompressedImage"},
+                {"/cam1/image", "sensor_msgs/msg/CompressedImage"},
+                {"/wheel_odom", "nav_msgs/msg/Odometry"},
+                {"/fused_odom", "nav_msgs/msg/Odometry"}};
+  bag.messages.push_back({0, 1'000'000'000, test::compressed_image_cdr(1, "c", "png", png)});
+  bag.messages.push_back({1, 1'000'000'000, test::compressed_image_cdr(1, "c", "png", png)});
+  bag.messages.push_back({2, 1'000'000'000, test::odometry_cdr(1, 0, 0, 0)});
+  bag.messages.push_back({3, 1'000'000'000, test::odometry_cdr(1, 0, 0, 0)});
+  const std::string path = bag.write("names.mcap");
+  // Neither the cameras nor the odometry can be told apart: the message lists every topic.
+  try {
+    read_mission_log(path);
+    ADD_FAILURE() << "read a bag whose topics it cannot tell apart";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.where().file, path);
+    EXPECT_THAT(e.what(), HasSubstr("--odometry-topic"));
+    EXPECT_THAT(e.what(), HasSubstr("/cam1/image (sensor_msgs/CompressedImage, 1 messages)"));
+  }
+  BagTopics t;
+  t.odometry = "/wheel_odom";
+  try {
+    read_mission_log(path, t);
+    ADD_FAILURE() << "read images without knowing which camera they are";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("--ceiling-topic"));
+  }
+  t.ceiling_image = "/cam1/image";
+  t.omni_image = "/cam0/image";
+  const MissionLog log = read_mission_log(path, t);
+  EXPECT_EQ(log.ceiling_images.size(), 1u);
+  EXPECT_EQ(log.omni_images.size(), 1u);
+  EXPECT_EQ(log.odometry.size(), 1u);
+  // A named topic that is not there, or not an image.
+  t.omni_image = "/cam2/image";
+  EXPECT_THROW(read_mission_log(path, t), InputError);
+  t.omni_image = "/fused_odom";
+  try {
+    read_mission_log(path, t);
+    ADD_FAILURE();
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("\"/fused_odom\" is a nav_msgs/Odometry"));
+  }
+  std::filesystem::remove(path);
+}
+
+// What cannot be read is skipped and said, with the topic, the message and the field; the rest is
+// kept.
+TEST(Ros2Bag, DamagedMessagesAreSkippedNamingTheField) {
+  const std::string png = encode_png(gradient(8, 8));
+  Bag bag;
+  bag.topics = {{"/ceiling/image", "sensor_msgs/msg/CompressedImage"},
+                {"/omni/image", "sensor_msgs/msg/Image"},
+                {"/odom", "nav_msgs/msg/Odometry"}};
+  const std::string good = test::compressed_image_cdr(1'000'000'000, "c", "png", png);
+  bag.messages.push_back({0, 1'000'000'000, good});
+  bag.messages.push_back({0, 1'100'000'000, good.substr(0, good.size() - 10)});  // cut short
+  bag.messages.push_back({0, 1'200'000'000, test::compressed_image_cdr(1, "c", "png", "GIF89a")});
+  std::string wrong_header = good;
+  wrong_header[1] = 7;
+  bag.messages.push_back({0, 1'300'000'000, wrong_header});
+  const Image8 g = gradient(4, 4);
+  bag.messages.push_back({1, 1'000'000'000, raw_image_cdr(g, "mono8", 3, true)});  // step < row
+  bag.messages.push_back({1, 1'000'000'000,
+                          CdrWriter()
+                              .header(1, "o")
+                              .u32(4)
+                              .u32(4)
+                              .string("yuv422")
+                              .u8(0)
+                              .u32(8)
+                              .bytes(std::string(32, 'x'))
+                              .data()});
+  std::string odo = test::odometry_cdr(1, 0, 0, 0);
+  bag.messages.push_back({2, 1'000'000'000, odo.substr(0, 60)});
+  // A sequence count far beyond the bytes left.
+  bag.messages.push_back({1, 1'000'000'000,
+                          CdrWriter()
+                              .header(1, "o")
+                              .u32(4)
+                              .u32(4)
+                              .string("mono8")
+                              .u8(0)
+                              .u32(4)
+                              .u32(0x7FFFFFFF)
+                              .data()});
+  const std::string path = bag.write("damaged.mcap");
+  const MissionLog log = read_mission_log(path);
+  std::filesystem::remove(path);
+  EXPECT_EQ(log.ceiling_images.size(), 1u);
+  EXPECT_EQ(log.skipped_messages, 7u);
+  std::string all;
+  for (const auto& p : log.problems) all += p + "\n";
+  EXPECT_THAT(all, HasSubstr("/ceiling/image message 1 (sensor_msgs/CompressedImage): field data"));
+  EXPECT_THAT(all, HasSubstr("neither PNG nor JPEG"));
+  EXPECT_THAT(all, HasSubstr("encapsulation header"));
+  EXPECT_THAT(all, HasSubstr("step 3 is shorter than a row"));
+  EXPECT_THAT(all, HasSubstr("encoding \"yuv422\" is not read"));
+  EXPECT_THAT(all, HasSubstr("/odom message 0"));
+  EXPECT_THAT(all, HasSubstr("sequence of 2147483647 elements"));
+}
+
+}  // namespace
+}  // namespace lampnav::io
