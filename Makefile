@@ -26,10 +26,12 @@ demo: build
 	$(LAMPNAV) run --out $(OUT)
 	@echo "open $(OUT)/report.html" >&2
 
-# The official TypeScript MCAP reader and Foxglove's schemas, for the interoperability tests (npm
-# registry, pinned by the lock file).
+# The official TypeScript MCAP reader and writer, Foxglove's schemas, and Foxglove's ROS 2 CDR
+# serializer with ROS 2's message definitions, for the interoperability tests (npm registry,
+# pinned by the lock file).
+INTEROP_PACKAGES = @mcap/core @foxglove/schemas @foxglove/rosmsg2-serialization @foxglove/rosmsg-msgs-common
 interop-deps: deps
-	@cd tests/interop && { [ -d node_modules/@mcap/core ] && [ -d node_modules/@foxglove/schemas ] || npm ci --no-audit --no-fund --loglevel=error; }
+	@cd tests/interop && { ( for p in $(INTEROP_PACKAGES); do [ -d node_modules/$$p ] || exit 1; done ) || npm ci --no-audit --no-fund --loglevel=error; }
 
 test: build interop-deps
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
