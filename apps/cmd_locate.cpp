@@ -74,9 +74,10 @@ int run_locate(const LocateArgs& a) {
   const RobotDescription robot = read_robot_description(a.robot);
   const CameraDescription* camera = robot.find_camera(a.camera);
   if (!camera) throw InputError({a.robot, "cameras", "name"}, "no camera named '" + a.camera + "'");
-  if (camera->model != CameraModelKind::pajdla_bakstein)
+  if (!is_fisheye(camera->model))
     throw InputError({a.robot, "cameras[" + a.camera + "]", "model"},
-                     "global localization needs an omnidirectional (pajdla_bakstein) camera");
+                     "global localization needs an omnidirectional (pajdla_bakstein or "
+                     "kannala_brandt) camera");
   const auto method = fusion::parse_global_method(a.method);
   if (!method)
     throw InputError({"", "--method", ""}, "'" + a.method + "' is not a method (paper, default)");

@@ -85,9 +85,26 @@ CameraDescription read_camera(const Cursor& c) {
       f.fov_deg = fov->positive();
       if (f.fov_deg >= 360.0) fov->fail("must be below 360 degrees");
     }
+  } else if (model == "kannala_brandt") {
+    c.only_keys(
+        {"name", "model", "width", "height", "fx", "fy", "cx", "cy", "k", "fov_deg", "mount"});
+    cam.model = CameraModelKind::kannala_brandt;
+    auto& f = cam.fisheye;
+    f.f = c.at("fx").positive();
+    f.beta = c.at("fy").positive() / f.f;
+    f.u0 = c.at("cx").number();
+    f.v0 = c.at("cy").number();
+    const Cursor k = c.at("k");
+    k.array_size(4, 4);
+    for (std::size_t i = 0; i < 4; ++i) f.k[i] = k[i].number();
+    f.fov_deg = 180.0;
+    if (auto fov = c.find("fov_deg")) {
+      f.fov_deg = fov->positive();
+      if (f.fov_deg >= 360.0) fov->fail("must be below 360 degrees");
+    }
   } else {
     c.at("model").fail("unknown camera model '" + model +
-                       "' (expected pinhole or pajdla_bakstein)");
+                       "' (expected pinhole, pajdla_bakstein or kannala_brandt)");
   }
   return cam;
 }
@@ -144,6 +161,15 @@ std::string to_robot_json(const RobotDescription& robot) {
       cj["cx"] = c.pinhole.cx;
       cj["cy"] = c.pinhole.cy;
       cj["distortion"] = c.pinhole.distortion;
+    } else if (c.model == CameraModelKind::kannala_brandt) {
+      const auto& f = c.fisheye;
+      cj["model"] = "kannala_brandt";
+      cj["fx"] = f.f;
+      cj["fy"] = f.f * f.beta;
+      cj["cx"] = f.u0;
+      cj["cy"] = f.v0;
+      cj["k"] = f.k;
+      cj["fov_deg"] = f.fov_deg;
     } else {
       const auto& f = c.fisheye;
       cj["model"] = "pajdla_bakstein";

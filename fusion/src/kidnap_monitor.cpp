@@ -46,8 +46,8 @@ OmniCheck::OmniCheck(const graph::TopologicalMap& map, const CameraDescription& 
                      const OmniCheckOptions& options)
     : map_(&map), mount_R_(camera.mount.rotation()), mount_t_(camera.mount.xyz), o_(options) {
   o_.validate();
-  if (camera.model != CameraModelKind::pajdla_bakstein)
-    throw Error("the omni check needs a pajdla_bakstein camera, '" + camera.name + "' is not");
+  if (!is_fisheye(camera.model))
+    throw Error("the omni check needs a fisheye camera, '" + camera.name + "' is not");
   double smallest = 1e9, highest = 0;
   for (const auto& n : map.nodes())
     for (const auto& l : n.lamps) {

@@ -200,7 +200,7 @@ Image8 CeilingRenderer::render(const Pose2& robot, const CameraTilt& tilt,
 OmniRenderer::OmniRenderer(const CameraDescription& camera, OmniRenderOptions options)
     : cam_(camera), o_(options) {
   o_.validate();
-  vision::FisheyeCamera check_model(camera);  // throws when not a pajdla_bakstein camera
+  vision::FisheyeCamera check_model(camera);  // throws when not a fisheye camera
   (void)check_model;
 }
 

@@ -1,5 +1,7 @@
+#include <opencv2/calib3d.hpp>
 #include <random>
 
+#include "lampnav/core/error.hpp"
 #include "lampnav/vision/camera_models.hpp"
 #include "lampnav_test.hpp"
 
@@ -106,6 +108,96 @@ TEST(FisheyeCamera, JacobianMatchesNumericalDerivative) {
     const auto J = test::numerical_jacobian<2, 3>(
         [&](const Vector3d& q) { return *cam.project(q); }, pt, 1e-7);
     EXPECT_LT((cam.project_jacobian(pt) - J).norm(), 1e-4 * (1 + J.norm())) << "theta " << t;
+  }
+}
+
+// A fisheye calibrated with OpenCV (cv::fisheye), ROS (equidistant) or Kalibr (pinhole-equi).
+CameraDescription kannala_brandt(double fx = 283.0, double fy = 285.0) {
+  CameraDescription d;
+  d.name = "omni_camera";
+  d.model = CameraModelKind::kannala_brandt;
+  d.width = 1024;
+  d.height = 1024;
+  d.fisheye.f = fx;
+  d.fisheye.beta = fy / fx;
+  d.fisheye.u0 = 511.2;
+  d.fisheye.v0 = 509.8;
+  d.fisheye.k = {0.021, -0.0064, 0.0009, -0.00011};
+  d.fisheye.fov_deg = 180;
+  return d;
+}
+
+// Our projection against OpenCV's own (cv::fisheye::projectPoints) over the whole image: every
+// 8th pixel unprojected to a ray, projected by both.
+TEST(KannalaBrandt, AgreesWithOpenCvsFisheyeOverTheWholeImage) {
+  const CameraDescription d = kannala_brandt();
+  const FisheyeCamera cam(d);
+  const cv::Matx33d K(d.fisheye.f, 0, d.fisheye.u0, 0, d.fisheye.f * d.fisheye.beta, d.fisheye.v0,
+                      0, 0, 1);
+  const cv::Vec4d D(d.fisheye.k[0], d.fisheye.k[1], d.fisheye.k[2], d.fisheye.k[3]);
+  std::vector<cv::Point3d> points;
+  std::vector<Vector2d> ours;
+  for (int v = 0; v < d.height; v += 8)
+    for (int u = 0; u < d.width; u += 8) {
+      const auto ray = cam.unproject(Vector2d(u, v));
+      // OpenCV's model sees in front of the lens only (Z > 0).
+      if (!ray || ray->z() < 0.02) continue;
+      points.emplace_back(2 * ray->x(), 2 * ray->y(), 2 * ray->z());
+      ours.push_back(*cam.project(2 * *ray));
+      EXPECT_LT((ours.back() - Vector2d(u, v)).norm(), 1e-6) << u << ", " << v;
+    }
+  ASSERT_GT(points.size(), 9000u);
+  std::vector<cv::Point2d> theirs;
+  cv::fisheye::projectPoints(points, theirs, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, D);
+  double worst = 0;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    worst = std::max(worst, (ours[i] - Vector2d(theirs[i].x, theirs[i].y)).norm());
+  std::cout << points.size() << " pixels, worst difference from OpenCV " << worst << " px\n";
+  EXPECT_LT(worst, 0.01);
+}
+
+TEST(KannalaBrandt, JacobianMatchesNumericalDerivativeAndRoundTrips) {
+  const FisheyeCamera cam(kannala_brandt());
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> th(0.05, cam.max_theta() - 0.01), ph(-M_PI, M_PI),
+      dist(1.0, 12.0);
+  for (int i = 0; i < 500; ++i) {
+    const double t = th(rng), p = ph(rng);
+    const Vector3d ray(std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t));
+    const Vector3d pt = dist(rng) * ray;
+    const auto J = test::numerical_jacobian<2, 3>(
+        [&](const Vector3d& q) { return *cam.project(q); }, pt, 1e-7);
+    EXPECT_LT((cam.project_jacobian(pt) - J).norm(), 1e-4 * (1 + J.norm())) << "theta " << t;
+    const auto back = cam.unproject(*cam.project(pt));
+    ASSERT_TRUE(back);
+    EXPECT_LT((*back - ray).norm(), 1e-9);
+  }
+  // A model whose radius folds back ends its field of view there, not at fov_deg.
+  CameraDescription folding = kannala_brandt();
+  folding.fisheye.k = {-0.3, 0, 0, 0};
+  const FisheyeCamera f(folding);
+  EXPECT_NEAR(f.max_theta(), std::sqrt(1 / 0.9), 1e-3);  // where 1 - 0.9 theta^2 = 0
+  EXPECT_GT(f.radius_derivative(f.max_theta()), 0);
+}
+
+TEST(KannalaBrandt, RobotJsonRoundTrip) {
+  RobotDescription r = pioneer();
+  r.cameras[1] = kannala_brandt();
+  const RobotDescription back = parse_robot_description(to_robot_json(r), "written");
+  const CameraDescription& c = *back.find_camera("omni_camera");
+  EXPECT_EQ(c.model, CameraModelKind::kannala_brandt);
+  EXPECT_DOUBLE_EQ(c.fisheye.f, 283.0);
+  EXPECT_DOUBLE_EQ(c.fisheye.f * c.fisheye.beta, 285.0);
+  EXPECT_EQ(c.fisheye.k, r.cameras[1].fisheye.k);
+  EXPECT_EQ(to_robot_json(back), to_robot_json(r));
+  // Its own fields only: a Pajdla-Bakstein field is an error naming it.
+  std::string text = to_robot_json(r);
+  text.replace(text.find("\"k\""), 3, "\"a\": 1, \"k\"");
+  try {
+    parse_robot_description(text, "bad.json");
+    ADD_FAILURE() << "read an unknown key";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("a: unknown key"));
   }
 }
 

@@ -108,14 +108,40 @@ Vector3d PinholeCamera::unproject(const Vector2d& px) const {
 
 FisheyeCamera::FisheyeCamera(const CameraDescription& d)
     : p_(d.fisheye), width_(d.width), height_(d.height) {
-  if (d.model != CameraModelKind::pajdla_bakstein) {
-    throw Error("camera '" + d.name + "' is not a pajdla_bakstein camera");
+  if (!is_fisheye(d.model)) {
+    throw Error("camera '" + d.name +
+                "' is not a fisheye (pajdla_bakstein or kannala_brandt) camera");
   }
+  kb_ = d.model == CameraModelKind::kannala_brandt;
   max_theta_ = 0.5 * p_.fov_deg * M_PI / 180.0;
+  // Beyond the angle where the radius stops growing the model folds back: that is the edge of
+  // its field of view.
+  const int steps = 2000;
+  for (int i = 1; i <= steps; ++i) {
+    const double t = max_theta_ * i / steps;
+    if (!(radius_derivative(t) > 0)) {
+      max_theta_ = max_theta_ * (i - 1) / steps;
+      break;
+    }
+  }
 }
 
 double FisheyeCamera::radius(double theta) const {
+  if (kb_) {
+    const double t2 = theta * theta;
+    return p_.f * theta * (1 + t2 * (p_.k[0] + t2 * (p_.k[1] + t2 * (p_.k[2] + t2 * p_.k[3]))));
+  }
   return p_.a * std::tan(theta / p_.b) + p_.c * std::sin(theta / p_.d);
+}
+
+double FisheyeCamera::radius_derivative(double theta) const {
+  if (kb_) {
+    const double t2 = theta * theta;
+    return p_.f *
+           (1 + t2 * (3 * p_.k[0] + t2 * (5 * p_.k[1] + t2 * (7 * p_.k[2] + t2 * 9 * p_.k[3]))));
+  }
+  const double sec = 1.0 / std::cos(theta / p_.b);
+  return p_.a / p_.b * sec * sec + p_.c / p_.d * std::cos(theta / p_.d);
 }
 
 std::optional<double> FisheyeCamera::theta_of_radius(double r) const {
@@ -146,8 +172,7 @@ Eigen::Matrix<double, 2, 3> FisheyeCamera::project_jacobian(const Vector3d& p) c
   const double n2 = rho2 + p.z() * p.z();
   const double theta = std::atan2(rho, p.z());
   const double cphi = p.x() / rho, sphi = p.y() / rho;
-  const double sec = 1.0 / std::cos(theta / p_.b);
-  const double dr = p_.a / p_.b * sec * sec + p_.c / p_.d * std::cos(theta / p_.d);
+  const double dr = radius_derivative(theta);
   const double r = radius(theta);
   // d theta / d (X, Y, Z) and d phi / d (X, Y, Z).
   const Eigen::RowVector3d dtheta(p.x() * p.z() / (rho * n2), p.y() * p.z() / (rho * n2),

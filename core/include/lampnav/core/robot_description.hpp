@@ -16,7 +16,11 @@ struct Mount {
   Eigen::Matrix3d rotation() const;
 };
 
-enum class CameraModelKind { pinhole, pajdla_bakstein };
+enum class CameraModelKind { pinhole, pajdla_bakstein, kannala_brandt };
+// The fisheye models: radially symmetric, a radius (px) for each angle off the optical axis.
+inline bool is_fisheye(CameraModelKind k) {
+  return k == CameraModelKind::pajdla_bakstein || k == CameraModelKind::kannala_brandt;
+}
 
 // OpenCV's radial-tangential model: [k1, k2, p1, p2, k3].
 struct PinholeParameters {
@@ -25,11 +29,16 @@ struct PinholeParameters {
 };
 
 // Pajdla-Bakstein: r = a tan(theta / b) + c sin(theta / d), valid beyond 90 degrees off-axis.
+// Kannala-Brandt (model kannala_brandt; OpenCV's cv::fisheye, ROS's equidistant, Kalibr's
+// pinhole-equi): r = fx theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8), u0 = cx,
+// v0 = cy, beta = fy / fx; its fov_deg defaults to 180.
 struct FisheyeParameters {
   double u0 = 0, v0 = 0;  // px, image centre
   double a = 0, b = 1, c = 0, d = 1;
-  double beta = 1.0;       // pixel aspect ratio, applied to the radial term only
-  double fov_deg = 185.0;  // full field of view, deg
+  double beta = 1.0;          // pixel aspect ratio, applied to the radial term only
+  double fov_deg = 185.0;     // full field of view, deg
+  double f = 0;               // kannala_brandt: fx (px)
+  std::array<double, 4> k{};  // kannala_brandt: k1 .. k4
 };
 
 struct CameraDescription {
@@ -37,7 +46,7 @@ struct CameraDescription {
   CameraModelKind model = CameraModelKind::pinhole;
   int width = 0, height = 0;  // px
   PinholeParameters pinhole;  // when model == pinhole
-  FisheyeParameters fisheye;  // when model == pajdla_bakstein
+  FisheyeParameters fisheye;  // when is_fisheye(model)
   Mount mount;
 };
 

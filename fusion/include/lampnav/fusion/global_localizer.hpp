@@ -113,7 +113,7 @@ struct GlobalLocalization {
 
 class GlobalLocalizer {
  public:
-  // Throws InputError for bad options, Error when the camera is not a pajdla_bakstein one.
+  // Throws InputError for bad options, Error when the camera is not a fisheye one (pajdla_bakstein, kannala_brandt).
   GlobalLocalizer(const graph::TopologicalMap& map, const CameraDescription& omni_camera,
                   const GlobalLocalizerOptions& options = {});
   ~GlobalLocalizer();

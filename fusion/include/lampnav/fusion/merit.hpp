@@ -20,7 +20,7 @@ namespace lampnav::fusion {
 // C^W), then the Pajdla-Bakstein model, Eqs. 1-2), with the camera mount of robot.json.
 class CeilingMapProjection {
  public:
-  // Throws Error when the camera is not a pajdla_bakstein one.
+  // Throws Error when the camera is not a fisheye one (pajdla_bakstein, kannala_brandt).
   CeilingMapProjection(const graph::TopologicalMap& map, const CameraDescription& omni_camera);
 
   // The pixels of the lamps inside the field of view and the image; `lamp` (if given) receives

@@ -50,8 +50,12 @@ class PinholeCamera {
   double max_r2_;  // normalized radius^2 where the distortion stops growing
 };
 
-// Pajdla-Bakstein fisheye: theta = atan2(sqrt(X^2+Y^2), Z), phi = atan2(Y, X),
-// r = a tan(theta / b) + c sin(theta / d), u = u0 + r cos(phi), v = v0 + beta r sin(phi).
+// The fisheye models: theta = atan2(sqrt(X^2+Y^2), Z), phi = atan2(Y, X), u = u0 + r cos(phi),
+// v = v0 + beta r sin(phi), with the radius r(theta) of
+//  - Pajdla-Bakstein: r = a tan(theta / b) + c sin(theta / d);
+//  - Kannala-Brandt: r = fx theta (1 + k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8)
+//    (OpenCV's cv::fisheye, ROS's equidistant, Kalibr's pinhole-equi; beta = fy / fx).
+// The field of view ends at fov_deg / 2 off the axis, or sooner where r(theta) stops growing.
 class FisheyeCamera {
  public:
   explicit FisheyeCamera(const CameraDescription& description);
@@ -61,8 +65,10 @@ class FisheyeCamera {
   const FisheyeParameters& parameters() const { return p_; }
   double max_theta() const { return max_theta_; }  // rad, half the field of view
 
-  // Radius (px) at an off-axis angle theta (rad), and its inverse on [0, max_theta].
+  // Radius (px) at an off-axis angle theta (rad), its derivative, and its inverse on
+  // [0, max_theta].
   double radius(double theta) const;
+  double radius_derivative(double theta) const;
   std::optional<double> theta_of_radius(double r) const;
 
   std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& point) const;
@@ -78,6 +84,7 @@ class FisheyeCamera {
   FisheyeParameters p_;
   int width_, height_;
   double max_theta_;
+  bool kb_ = false;  // Kannala-Brandt, else Pajdla-Bakstein
 };
 
 // How long a stretch of ceiling the camera sees along the robot's forward axis (base x), on the

@@ -46,7 +46,7 @@ struct OmniDetection {
 
 class OmniLampDetector {
  public:
-  // Throws InputError when the camera is not a pajdla_bakstein one or the options are bad.
+  // Throws InputError when the camera is not a fisheye one or the options are bad.
   explicit OmniLampDetector(const CameraDescription& camera,
                             const OmniDetectorOptions& options = {});
   ~OmniLampDetector();
