@@ -12,6 +12,8 @@ packages=(
   libcairo2-dev libzstd-dev
   # least squares for map building (mapping/)
   libceres-dev
+  # YAML calibration files of ROS and Kalibr (io/, robot import), as ROS reads them
+  libyaml-cpp-dev
   # tests and benchmarks; Chromium opens the report headless in a test
   libgtest-dev libgmock-dev libbenchmark-dev chromium
 )

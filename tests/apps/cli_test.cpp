@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_support.hpp"
+#include "lampnav/core/robot_description.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav_test.hpp"
 
@@ -211,6 +212,50 @@ TEST(Cli, LocateSaysWhyWhenThereIsNoPoseOrTheInputIsBad) {
   EXPECT_EQ(nocam.status, 2);
   EXPECT_THAT(nocam.err, HasSubstr("no camera named 'nope'"));
   for (const auto& f : {dark, small, text}) std::filesystem::remove(f);
+}
+
+}  // namespace
+}  // namespace lampnav
+
+namespace lampnav {
+namespace {
+
+// robot import: the cameras from calibration files, the wheels and mounts kept.
+TEST(Cli, RobotImportTakesCalibrationsKeepingWheelsAndMounts) {
+  const auto dir = std::filesystem::temp_directory_path();
+  const std::string calib = (dir / ("lampnav_cli_calib_" + std::to_string(::getpid()) + ".yaml"));
+  const std::string out = (dir / ("lampnav_cli_robot_" + std::to_string(::getpid()) + ".json"));
+  std::ofstream(calib) << "image_width: 1280\nimage_height: 1024\ncamera_name: omni\n"
+                          "camera_matrix: {rows: 3, cols: 3, data: [402.1, 0, 641.3, 0, 401.7, "
+                          "509.2, 0, 0, 1]}\ndistortion_model: equidistant\n"
+                          "distortion_coefficients: {rows: 1, cols: 4, data: [0.034, -0.0041, "
+                          "0.00062, -0.00009]}\n";
+  const Result r = run("robot import '" + calib + "' --robot " + src("maps/robots/pioneer.json") +
+                       " -o '" + out + "'");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.out,
+              HasSubstr("omni_camera: pajdla_bakstein 1024 x 1024 -> kannala_brandt 1280 x 1024"));
+  const RobotDescription robot = read_robot_description(out);
+  const RobotDescription before =
+      read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  const CameraDescription& omni = *robot.find_camera("omni_camera");
+  EXPECT_EQ(omni.model, CameraModelKind::kannala_brandt);
+  EXPECT_EQ(omni.width, 1280);
+  EXPECT_EQ(omni.mount.xyz, before.find_camera("omni_camera")->mount.xyz);
+  EXPECT_EQ(robot.semi_axis, before.semi_axis);
+  EXPECT_EQ(robot.find_camera("ceiling_camera")->pinhole.fx,
+            before.find_camera("ceiling_camera")->pinhole.fx);
+  // A fisheye cannot be the ceiling camera; a file that is not a calibration names itself.
+  const Result ceiling = run("robot import '" + calib + "' --camera ceiling_camera --robot " +
+                             src("maps/robots/pioneer.json") + " -o '" + out + "'");
+  EXPECT_EQ(ceiling.status, 2);
+  EXPECT_THAT(ceiling.err, HasSubstr("must be a pinhole camera"));
+  const Result bad = run("robot import " + src("maps/office_floor.geojson") + " --robot " +
+                         src("maps/robots/pioneer.json") + " -o '" + out + "'");
+  EXPECT_EQ(bad.status, 2);
+  EXPECT_THAT(bad.err, HasSubstr("office_floor.geojson"));
+  std::filesystem::remove(calib);
+  std::filesystem::remove(out);
 }
 
 }  // namespace

@@ -1,0 +1,299 @@
+#include "lampnav/io/calibration.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <opencv2/core.hpp>
+#include <sstream>
+
+#include "lampnav/core/error.hpp"
+
+namespace lampnav::io {
+
+namespace {
+
+// A parsed file as a plain tree, whichever parser read it: yaml-cpp for the YAML of ROS and Kalibr
+// (block sequences under a key at its own indentation, which OpenCV's reader refuses), OpenCV's
+// cv::FileStorage for OpenCV's own XML and "%YAML:1.0" files (its !!opencv-matrix).
+struct Node {
+  enum Kind { none, scalar, list, map } kind = none;
+  std::string text;  // a scalar as written
+  std::vector<Node> items;
+  std::map<std::string, Node> keys;
+  const Node& operator[](const std::string& key) const {
+    static const Node missing;
+    const auto it = keys.find(key);
+    return it == keys.end() ? missing : it->second;
+  }
+  bool empty() const { return kind == none; }
+};
+
+Node from_yaml(const YAML::Node& y) {
+  Node n;
+  if (y.IsScalar()) {
+    n.kind = Node::scalar;
+    n.text = y.Scalar();
+  } else if (y.IsSequence()) {
+    n.kind = Node::list;
+    for (const auto& item : y) n.items.push_back(from_yaml(item));
+  } else if (y.IsMap()) {
+    n.kind = Node::map;
+    for (const auto& kv : y) n.keys[kv.first.as<std::string>()] = from_yaml(kv.second);
+  }
+  return n;
+}
+
+Node from_opencv(const cv::FileNode& f) {
+  Node n;
+  if (f.isInt() || f.isReal()) {
+    n.kind = Node::scalar;
+    std::ostringstream s;
+    s.precision(17);
+    s << static_cast<double>(f);
+    n.text = s.str();
+  } else if (f.isString()) {
+    n.kind = Node::scalar;
+    n.text = static_cast<std::string>(f);
+  } else if (f.isSeq()) {
+    n.kind = Node::list;
+    for (const auto& item : f) n.items.push_back(from_opencv(item));
+  } else if (f.isMap()) {
+    n.kind = Node::map;
+    for (const auto& item : f) n.keys[item.name()] = from_opencv(item);
+  }
+  return n;
+}
+
+// One place in one file, for errors.
+struct Where {
+  std::string file, place;
+  [[noreturn]] void fail(const std::string& field, const std::string& what) const {
+    throw InputError({file, place, field}, what);
+  }
+};
+
+const char* kind_name(const Node& n) {
+  switch (n.kind) {
+    case Node::none:
+      return "nothing";
+    case Node::scalar:
+      return "a value";
+    case Node::list:
+      return "a list";
+    case Node::map:
+      return "a map";
+  }
+  return "?";
+}
+
+const Node& need(const Node& parent, const std::string& key, const Where& w) {
+  const Node& n = parent[key];
+  if (n.empty()) w.fail(key, "missing");
+  return n;
+}
+
+double number(const Node& n, const std::string& field, const Where& w) {
+  if (n.kind != Node::scalar) w.fail(field, std::string("must be a number, is ") + kind_name(n));
+  char* end = nullptr;
+  const double v = std::strtod(n.text.c_str(), &end);
+  if (n.text.empty() || *end != 0) w.fail(field, "'" + n.text + "' is not a number");
+  if (!std::isfinite(v)) w.fail(field, "must be finite");
+  return v;
+}
+
+std::string text(const Node& n, const std::string& field, const Where& w) {
+  if (n.kind != Node::scalar) w.fail(field, std::string("must be text, is ") + kind_name(n));
+  return n.text;
+}
+
+int pixels(const Node& n, const std::string& field, const Where& w) {
+  const double v = number(n, field, w);
+  if (v != std::floor(v) || v < 1 || v > 100000)
+    w.fail(field, "must be a pixel count, 1 to 100000");
+  return static_cast<int>(v);
+}
+
+// A list of numbers, or a matrix: ROS's {rows, cols, data}, OpenCV's !!opencv-matrix (the same
+// keys, and dt).
+std::vector<double> numbers(const Node& n, const std::string& field, const Where& w) {
+  std::vector<double> out;
+  if (n.kind == Node::map) {
+    const Node& data = need(n, "data", w);
+    if (data.kind != Node::list) w.fail(field + ".data", "must be a list of numbers");
+    for (const auto& x : data.items) out.push_back(number(x, field + ".data", w));
+    if (!n["rows"].empty() && !n["cols"].empty()) {
+      const double rows = number(n["rows"], field + ".rows", w),
+                   cols = number(n["cols"], field + ".cols", w);
+      if (rows * cols != double(out.size()))
+        w.fail(field, "rows x cols is " + std::to_string(int(rows * cols)) + " but data holds " +
+                          std::to_string(out.size()) + " numbers");
+    }
+    return out;
+  }
+  if (n.kind != Node::list)
+    w.fail(field, std::string("must be a list of numbers, is ") + kind_name(n));
+  for (const auto& x : n.items) out.push_back(number(x, field, w));
+  return out;
+}
+
+// fx, fy, cx, cy from a 3 x 3 camera matrix (no skew).
+void from_matrix(const std::vector<double>& K, const std::string& field, const Where& w, double& fx,
+                 double& fy, double& cx, double& cy) {
+  if (K.size() != 9)
+    w.fail(field, "must be a 3 x 3 matrix (9 numbers), has " + std::to_string(K.size()));
+  if (K[1] != 0) w.fail(field, "has skew (K[0][1] = " + std::to_string(K[1]) + "): not read");
+  if (K[3] != 0 || K[6] != 0 || K[7] != 0 || K[8] != 1)
+    w.fail(field, "is not a camera matrix [fx 0 cx; 0 fy cy; 0 0 1]");
+  fx = K[0];
+  fy = K[4];
+  cx = K[2];
+  cy = K[5];
+  if (!(fx > 0) || !(fy > 0)) w.fail(field, "focal lengths must be positive");
+}
+
+// The camera from a distortion model and its coefficients.
+CameraDescription camera(const std::string& model, const std::vector<double>& d, double fx,
+                         double fy, double cx, double cy, int width, int height,
+                         const std::string& field, const Where& w) {
+  CameraDescription c;
+  c.width = width;
+  c.height = height;
+  if (model == "plumb_bob" || model == "radtan" || model == "radial-tangential") {
+    if (d.size() != 4 && d.size() != 5)
+      w.fail(field, model + " needs 4 or 5 coefficients (k1 k2 p1 p2 [k3]), has " +
+                        std::to_string(d.size()));
+    c.model = CameraModelKind::pinhole;
+    c.pinhole = {fx, fy, cx, cy, {d[0], d[1], d[2], d[3], d.size() == 5 ? d[4] : 0.0}};
+  } else if (model == "rational_polynomial") {
+    if (d.size() != 8)
+      w.fail(field, "rational_polynomial needs 8 coefficients, has " + std::to_string(d.size()));
+    if (d[5] != 0 || d[6] != 0 || d[7] != 0)
+      w.fail(field,
+             "rational_polynomial with k4, k5 or k6 not zero is not read (robot.json's "
+             "pinhole has k1 k2 p1 p2 k3)");
+    c.model = CameraModelKind::pinhole;
+    c.pinhole = {fx, fy, cx, cy, {d[0], d[1], d[2], d[3], d[4]}};
+  } else if (model == "equidistant" || model == "fisheye" || model == "pinhole-equi") {
+    if (d.size() != 4)
+      w.fail(field, model + " needs 4 coefficients (k1 k2 k3 k4), has " + std::to_string(d.size()));
+    c.model = CameraModelKind::kannala_brandt;
+    c.fisheye.f = fx;
+    c.fisheye.beta = fy / fx;
+    c.fisheye.u0 = cx;
+    c.fisheye.v0 = cy;
+    c.fisheye.k = {d[0], d[1], d[2], d[3]};
+    c.fisheye.fov_deg = 180;
+  } else {
+    w.fail(field, "distortion model '" + model +
+                      "' is not read (plumb_bob, radtan, rational_polynomial, equidistant)");
+  }
+  return c;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError({path, "", ""}, "cannot open the file");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+}  // namespace
+
+std::vector<ImportedCamera> read_calibration(const std::string& path) {
+  const std::string data = slurp(path);
+  Node root;
+  const bool opencv = data.rfind("%YAML:1.", 0) == 0 ||
+                      (data.find("<?xml") != std::string::npos && data.find("<?xml") < 16);
+  if (opencv) {
+    try {
+      cv::FileStorage fs(data, cv::FileStorage::READ | cv::FileStorage::MEMORY);
+      if (!fs.isOpened()) throw InputError({path, "", ""}, "not a YAML or XML calibration file");
+      root = from_opencv(fs.root());
+    } catch (const cv::Exception& e) {
+      throw InputError({path, "", ""}, "not a YAML or XML calibration file: " + e.err);
+    }
+  } else {
+    try {
+      root = from_yaml(YAML::Load(data));
+    } catch (const YAML::Exception& e) {
+      throw InputError({path, "line " + std::to_string(e.mark.line + 1), ""},
+                       "not a YAML or XML calibration file: " + e.msg);
+    }
+  }
+  if (root.kind != Node::map)
+    throw InputError({path, "", ""}, "a calibration file holds a map of keys");
+  std::vector<ImportedCamera> out;
+  Where w{path, ""};
+  if (!root["camera_matrix"].empty() && !root["distortion_model"].empty()) {
+    // ROS camera_info.
+    ImportedCamera ic;
+    ic.format = "ROS camera_info";
+    w.place = root["camera_name"].kind == Node::scalar ? root["camera_name"].text : "";
+    ic.label = w.place;
+    double fx, fy, cx, cy;
+    from_matrix(numbers(root["camera_matrix"], "camera_matrix", w), "camera_matrix", w, fx, fy, cx,
+                cy);
+    ic.camera = camera(
+        text(root["distortion_model"], "distortion_model", w),
+        numbers(need(root, "distortion_coefficients", w), "distortion_coefficients", w), fx, fy, cx,
+        cy, pixels(need(root, "image_width", w), "image_width", w),
+        pixels(need(root, "image_height", w), "image_height", w), "distortion_coefficients", w);
+    out.push_back(std::move(ic));
+  } else if (!root["camera_matrix"].empty()) {
+    // OpenCV's calibration sample.
+    ImportedCamera ic;
+    ic.format = "OpenCV";
+    double fx, fy, cx, cy;
+    from_matrix(numbers(root["camera_matrix"], "camera_matrix", w), "camera_matrix", w, fx, fy, cx,
+                cy);
+    const std::vector<double> d =
+        numbers(need(root, "distortion_coefficients", w), "distortion_coefficients", w);
+    const bool fisheye =
+        !root["fisheye_model"].empty() && number(root["fisheye_model"], "fisheye_model", w) != 0;
+    const std::string model = fisheye         ? "fisheye"
+                              : d.size() == 8 ? "rational_polynomial"
+                                              : "plumb_bob";
+    ic.camera = camera(
+        model, d, fx, fy, cx, cy, pixels(need(root, "image_width", w), "image_width", w),
+        pixels(need(root, "image_height", w), "image_height", w), "distortion_coefficients", w);
+    out.push_back(std::move(ic));
+  } else {
+    // Kalibr camchain: cam0, cam1, ...
+    for (int k = 0;; ++k) {
+      const std::string key = "cam" + std::to_string(k);
+      const Node& cam = root[key];
+      if (cam.empty()) break;
+      w.place = key;
+      if (cam.kind != Node::map) w.fail("", "must be a map");
+      ImportedCamera ic;
+      ic.format = "Kalibr camchain";
+      ic.label = key;
+      if (cam["rostopic"].kind == Node::scalar) ic.label += " (" + cam["rostopic"].text + ")";
+      const std::string projection = text(need(cam, "camera_model", w), "camera_model", w);
+      if (projection != "pinhole")
+        w.fail("camera_model",
+               "'" + projection + "' is not read (pinhole, with radtan or equidistant distortion)");
+      const std::vector<double> in = numbers(need(cam, "intrinsics", w), "intrinsics", w);
+      if (in.size() != 4) w.fail("intrinsics", "must be [fu, fv, pu, pv]");
+      if (!(in[0] > 0) || !(in[1] > 0)) w.fail("intrinsics", "focal lengths must be positive");
+      const std::vector<double> res = numbers(need(cam, "resolution", w), "resolution", w);
+      if (res.size() != 2 || res[0] < 1 || res[1] < 1 || res[0] != std::floor(res[0]) ||
+          res[1] != std::floor(res[1]) || res[0] > 100000 || res[1] > 100000)
+        w.fail("resolution", "must be [width, height] in pixels");
+      ic.camera = camera(text(need(cam, "distortion_model", w), "distortion_model", w),
+                         numbers(need(cam, "distortion_coeffs", w), "distortion_coeffs", w), in[0],
+                         in[1], in[2], in[3], int(res[0]), int(res[1]), "distortion_coeffs", w);
+      out.push_back(std::move(ic));
+    }
+    if (out.empty())
+      throw InputError({path, "", ""},
+                       "not a calibration lampnav reads: no camera_matrix (ROS camera_info, "
+                       "OpenCV) and no cam0 (Kalibr camchain)");
+  }
+  return out;
+}
+
+}  // namespace lampnav::io

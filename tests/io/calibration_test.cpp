@@ -1,0 +1,250 @@
+// Calibrations from the usual tools become robot.json cameras that project as the tools' own
+// models do: OpenCV's cv::projectPoints (radial-tangential) and cv::fisheye::projectPoints
+// (Kannala-Brandt), compared over the whole image to 0.01 px. OpenCV's files are written by
+// OpenCV's own cv::FileStorage; ROS camera_info and Kalibr camchain files as those tools write
+// them.
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core.hpp>
+
+#include "lampnav/core/error.hpp"
+#include "lampnav/io/calibration.hpp"
+#include "lampnav/vision/camera_models.hpp"
+#include "lampnav_test.hpp"
+
+namespace lampnav::io {
+namespace {
+
+using Eigen::Vector2d;
+using Eigen::Vector3d;
+using ::testing::HasSubstr;
+
+std::string temp_file(const std::string& name) {
+  return (std::filesystem::temp_directory_path() /
+          ("lampnav_calib_" + std::to_string(::getpid()) + "_" + name))
+      .string();
+}
+
+std::string write(const std::string& name, const std::string& text) {
+  const std::string path = temp_file(name);
+  std::ofstream(path) << text;
+  return path;
+}
+
+// The worst distance (px) between our projection of the imported camera and OpenCV's, over rays
+// through every 4th pixel of the image.
+double worst_against_opencv(const CameraDescription& c, const cv::Matx33d& K,
+                            const std::vector<double>& D, bool fisheye) {
+  std::vector<cv::Point3d> points;
+  std::vector<Vector2d> ours;
+  if (fisheye) {
+    const vision::FisheyeCamera cam(c);
+    for (int v = 0; v < c.height; v += 4)
+      for (int u = 0; u < c.width; u += 4) {
+        const auto ray = cam.unproject(Vector2d(u, v));
+        if (!ray || ray->z() < 0.02) continue;
+        points.emplace_back(ray->x(), ray->y(), ray->z());
+        ours.push_back(*cam.project(*ray));
+      }
+  } else {
+    const vision::PinholeCamera cam(c);
+    for (int v = 0; v < c.height; v += 4)
+      for (int u = 0; u < c.width; u += 4) {
+        const Vector3d ray = cam.unproject(Vector2d(u, v));
+        const auto px = cam.project(ray);
+        if (!px) continue;
+        points.emplace_back(ray.x(), ray.y(), ray.z());
+        ours.push_back(*px);
+      }
+  }
+  EXPECT_GT(points.size(), std::size_t(c.width * c.height / 16 / 2));
+  std::vector<cv::Point2d> theirs;
+  if (fisheye)
+    cv::fisheye::projectPoints(points, theirs, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K,
+                               cv::Vec4d(D[0], D[1], D[2], D[3]));
+  else
+    cv::projectPoints(points, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), K, D, theirs);
+  double worst = 0;
+  for (std::size_t i = 0; i < points.size(); ++i)
+    worst = std::max(worst, (ours[i] - Vector2d(theirs[i].x, theirs[i].y)).norm());
+  return worst;
+}
+
+TEST(Calibration, RosCameraInfoPlumbBobAndEquidistant) {
+  const std::string webcam = write("webcam.yaml", R"(image_width: 640
+image_height: 480
+camera_name: ceiling_webcam
+camera_matrix:
+  rows: 3
+  cols: 3
+  data: [612.3, 0, 318.2, 0, 610.8, 241.7, 0, 0, 1]
+distortion_model: plumb_bob
+distortion_coefficients:
+  rows: 1
+  cols: 5
+  data: [-0.112, 0.071, 0.0012, -0.0007, -0.013]
+rectification_matrix:
+  rows: 3
+  cols: 3
+  data: [1, 0, 0, 0, 1, 0, 0, 0, 1]
+projection_matrix:
+  rows: 3
+  cols: 4
+  data: [612.3, 0, 318.2, 0, 0, 610.8, 241.7, 0, 0, 0, 1, 0]
+)");
+  const auto w = read_calibration(webcam);
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_EQ(w[0].format, "ROS camera_info");
+  EXPECT_EQ(w[0].label, "ceiling_webcam");
+  EXPECT_EQ(w[0].camera.model, CameraModelKind::pinhole);
+  const double worst_pinhole =
+      worst_against_opencv(w[0].camera, cv::Matx33d(612.3, 0, 318.2, 0, 610.8, 241.7, 0, 0, 1),
+                           {-0.112, 0.071, 0.0012, -0.0007, -0.013}, false);
+  const std::string fish = write("fish.yaml", R"(image_width: 1280
+image_height: 1024
+camera_name: omni
+camera_matrix: {rows: 3, cols: 3, data: [402.1, 0, 641.3, 0, 401.7, 509.2, 0, 0, 1]}
+distortion_model: equidistant
+distortion_coefficients: {rows: 1, cols: 4, data: [0.034, -0.0041, 0.00062, -0.00009]}
+)");
+  const auto f = read_calibration(fish);
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_EQ(f[0].camera.model, CameraModelKind::kannala_brandt);
+  const double worst_fisheye =
+      worst_against_opencv(f[0].camera, cv::Matx33d(402.1, 0, 641.3, 0, 401.7, 509.2, 0, 0, 1),
+                           {0.034, -0.0041, 0.00062, -0.00009}, true);
+  std::cout << "against OpenCV: pinhole " << worst_pinhole << " px, fisheye " << worst_fisheye
+            << " px\n";
+  EXPECT_LT(worst_pinhole, 0.01);
+  EXPECT_LT(worst_fisheye, 0.01);
+  std::filesystem::remove(webcam);
+  std::filesystem::remove(fish);
+}
+
+TEST(Calibration, KalibrCamchainWithBothCameras) {
+  const std::string path = write("camchain.yaml", R"(cam0:
+  cam_overlaps: []
+  camera_model: pinhole
+  distortion_coeffs: [-0.29, 0.08, 0.00019, 1.9e-05]
+  distortion_model: radtan
+  intrinsics: [458.654, 457.296, 367.215, 248.375]
+  resolution: [752, 480]
+  rostopic: /ceiling/image_raw
+cam1:
+  T_cn_cnm1:
+  - [0.99, 0.01, 0.0, -0.11]
+  - [-0.01, 0.99, 0.0, 0.0]
+  - [0.0, 0.0, 1.0, 0.0]
+  - [0.0, 0.0, 0.0, 1.0]
+  camera_model: pinhole
+  distortion_coeffs: [-0.0134, 0.0212, -0.0159, 0.0036]
+  distortion_model: equidistant
+  intrinsics: [190.97, 190.97, 254.93, 256.89]
+  resolution: [512, 512]
+  rostopic: /omni/image_raw
+)");
+  const auto cams = read_calibration(path);
+  std::filesystem::remove(path);
+  ASSERT_EQ(cams.size(), 2u);
+  EXPECT_EQ(cams[0].label, "cam0 (/ceiling/image_raw)");
+  EXPECT_EQ(cams[0].camera.model, CameraModelKind::pinhole);
+  EXPECT_EQ(cams[0].camera.width, 752);
+  EXPECT_EQ(cams[1].camera.model, CameraModelKind::kannala_brandt);
+  EXPECT_LT(worst_against_opencv(cams[0].camera,
+                                 cv::Matx33d(458.654, 0, 367.215, 0, 457.296, 248.375, 0, 0, 1),
+                                 {-0.29, 0.08, 0.00019, 1.9e-05, 0}, false),
+            0.01);
+  EXPECT_LT(worst_against_opencv(cams[1].camera,
+                                 cv::Matx33d(190.97, 0, 254.93, 0, 190.97, 256.89, 0, 0, 1),
+                                 {-0.0134, 0.0212, -0.0159, 0.0036}, true),
+            0.01);
+}
+
+// Files written by OpenCV's own cv::FileStorage, XML and YAML, as its calibration sample does.
+TEST(Calibration, OpenCvFilesWrittenByOpenCv) {
+  for (const char* ext : {".xml", ".yaml"}) {
+    for (const bool fisheye : {false, true}) {
+      const std::string path = temp_file(std::string("opencv") + (fisheye ? "_fish" : "") + ext);
+      const cv::Matx33d K(500.5, 0, 319.1, 0, 501.2, 238.9, 0, 0, 1);
+      const std::vector<double> D = fisheye
+                                        ? std::vector<double>{0.05, -0.01, 0.002, -0.0002}
+                                        : std::vector<double>{-0.2, 0.05, 0.001, 0.0005, -0.004};
+      {
+        cv::FileStorage fs(path, cv::FileStorage::WRITE);
+        fs << "image_width" << 640 << "image_height" << 480;
+        fs << "camera_matrix" << cv::Mat(K);
+        fs << "distortion_coefficients" << cv::Mat(D);
+        if (fisheye) fs << "fisheye_model" << 1;
+        fs << "avg_reprojection_error" << 0.21;
+      }
+      const auto cams = read_calibration(path);
+      std::filesystem::remove(path);
+      ASSERT_EQ(cams.size(), 1u) << ext;
+      EXPECT_EQ(cams[0].format, "OpenCV");
+      EXPECT_EQ(cams[0].camera.model,
+                fisheye ? CameraModelKind::kannala_brandt : CameraModelKind::pinhole);
+      EXPECT_LT(worst_against_opencv(cams[0].camera, K, D, fisheye), 0.01) << ext;
+    }
+  }
+}
+
+TEST(Calibration, WhatCannotBeReadIsRefusedNamingFileAndField) {
+  auto refused = [](const std::string& name, const std::string& text, const std::string& field,
+                    const std::string& what) {
+    const std::string path = write(name, text);
+    try {
+      read_calibration(path);
+      ADD_FAILURE() << name << " was read";
+    } catch (const InputError& e) {
+      EXPECT_EQ(e.where().file, path) << name;
+      EXPECT_EQ(e.where().field, field) << name << ": " << e.what();
+      EXPECT_THAT(e.what(), HasSubstr(what)) << name;
+    }
+    std::filesystem::remove(path);
+  };
+  const std::string matrix =
+      "camera_matrix: {rows: 3, cols: 3, data: [300, 0, 160, 0, 300, 120, 0, 0, 1]}\n";
+  refused(
+      "model.yaml",
+      "image_width: 320\nimage_height: 240\n" + matrix +
+          "distortion_model: unified\ndistortion_coefficients: {rows: 1, cols: 1, data: [0.9]}\n",
+      "distortion_coefficients", "distortion model 'unified' is not read");
+  refused("count.yaml",
+          "image_width: 320\nimage_height: 240\n" + matrix +
+              "distortion_model: equidistant\ndistortion_coefficients: {rows: 1, cols: 3, data: "
+              "[0.1, 0.2, 0.3]}\n",
+          "distortion_coefficients", "needs 4 coefficients");
+  refused("skew.yaml",
+          "image_width: 320\nimage_height: 240\ncamera_matrix: {rows: 3, cols: 3, data: [300, 2, "
+          "160, 0, 300, 120, 0, 0, 1]}\ndistortion_model: plumb_bob\ndistortion_coefficients: "
+          "{rows: 1, cols: 5, data: [0, 0, 0, 0, 0]}\n",
+          "camera_matrix", "skew");
+  refused(
+      "rows.yaml",
+      "image_width: 320\nimage_height: 240\ncamera_matrix: {rows: 3, cols: 3, data: [300, 0, "
+      "160, 0, 300, 120]}\ndistortion_model: plumb_bob\ndistortion_coefficients: [0, 0, 0, 0]\n",
+      "camera_matrix", "data holds 6 numbers");
+  refused("width.yaml",
+          "image_width: -3\nimage_height: 240\n" + matrix +
+              "distortion_model: plumb_bob\ndistortion_coefficients: [0, 0, 0, 0]\n",
+          "image_width", "pixel count");
+  refused(
+      "kalibr.yaml",
+      "cam0:\n  camera_model: omni\n  intrinsics: [0.8, 300, 300, 160, 120]\n"
+      "  distortion_model: radtan\n  distortion_coeffs: [0, 0, 0, 0]\n  resolution: [320, 240]\n",
+      "camera_model", "'omni' is not read");
+  refused(
+      "kalibr2.yaml",
+      "cam0:\n  camera_model: pinhole\n  intrinsics: [300, 300, 160]\n"
+      "  distortion_model: radtan\n  distortion_coeffs: [0, 0, 0, 0]\n  resolution: [320, 240]\n",
+      "intrinsics", "[fu, fv, pu, pv]");
+  refused("other.yaml", "name: something\nsize: 3\n", "", "not a calibration lampnav reads");
+  refused("garbage.yaml", "{{{{ not yaml", "", "not a YAML or XML calibration file");
+}
+
+}  // namespace
+}  // namespace lampnav::io
