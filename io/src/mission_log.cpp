@@ -5,16 +5,15 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
-#include <thread>
 
 #include "lampnav/core/error.hpp"
+#include "parallel.hpp"
 
 namespace lampnav::io {
 
@@ -481,17 +480,7 @@ MissionLog read_mission_log(const std::string& path, const BagTopics& bag_topics
           ch->topic + " message " + std::to_string(m.sequence) + ": " + e.what() + " (skipped)";
     }
   };
-  {
-    std::atomic<std::size_t> next{0};
-    auto work = [&] {
-      for (std::size_t i = next++; i < decoded.size(); i = next++) decode(i);
-    };
-    const unsigned n = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
-    std::vector<std::thread> pool;
-    for (unsigned k = 1; k < n && decoded.size() > 64; ++k) pool.emplace_back(work);
-    work();
-    for (auto& t : pool) t.join();
-  }
+  for_each_index(decoded.size(), decode);
   for (auto& d : decoded) {
     switch (d.kind) {
       case Decoded::wheels:

@@ -1,13 +1,12 @@
 #include "ros2_bag.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
 #include <sstream>
-#include <thread>
 
 #include "cdr.hpp"
 #include "lampnav/core/error.hpp"
+#include "parallel.hpp"
 
 namespace lampnav::io {
 
@@ -29,6 +28,13 @@ bool is_image(const std::string& type) {
 struct Header {
   Stamp stamp;
   std::string frame_id;
+  // A frame stamped and named by the header.
+  ImageFrame frame() const {
+    ImageFrame f;
+    f.stamp = stamp;
+    f.frame_id = frame_id;
+    return f;
+  }
 };
 
 Header header(CdrReader& r) {
@@ -46,10 +52,7 @@ Header header(CdrReader& r) {
 // by the free-text `format`).
 ImageFrame compressed_image(const std::string& data) {
   CdrReader r(data);
-  ImageFrame f;
-  const Header h = header(r);
-  f.stamp = h.stamp;
-  f.frame_id = h.frame_id;
+  ImageFrame f = header(r).frame();
   const std::string format = r.string("format");
   f.data = r.bytes("data");
   const auto* b = reinterpret_cast<const unsigned char*>(f.data.data());
@@ -65,10 +68,7 @@ ImageFrame compressed_image(const std::string& data) {
 // sensor_msgs/msg/Image: grey from the supported encodings, kept as a fast PNG.
 ImageFrame raw_image(const std::string& data) {
   CdrReader r(data);
-  ImageFrame f;
-  const Header h = header(r);
-  f.stamp = h.stamp;
-  f.frame_id = h.frame_id;
+  ImageFrame f = header(r).frame();
   const std::uint32_t height = r.u32("height"), width = r.u32("width");
   const std::string encoding = r.string("encoding");
   const bool big_endian = r.u8("is_bigendian") != 0;
@@ -288,17 +288,7 @@ void read_ros2_messages(const McapFile& f, const std::string& path, const BagTop
           ch->topic + " message " + std::to_string(m.sequence) + ": " + e.what() + " (skipped)";
     }
   };
-  {
-    std::atomic<std::size_t> next{0};
-    auto work = [&] {
-      for (std::size_t i = next++; i < decoded.size(); i = next++) decode(i);
-    };
-    const unsigned n = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
-    std::vector<std::thread> pool;
-    for (unsigned k = 1; k < n && decoded.size() > 64; ++k) pool.emplace_back(work);
-    work();
-    for (auto& t : pool) t.join();
-  }
+  for_each_index(decoded.size(), decode);
   log.ros2_bag = true;
   for (auto& d : decoded) {
     switch (d.kind) {

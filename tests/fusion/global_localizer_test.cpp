@@ -232,12 +232,16 @@ TEST(GlobalLocalizer, SymmetricCeilingGivesSeveralHypothesesAndSaysSo) {
 // must be found (the truth among the hypotheses) or reported ambiguous, and then the truth must
 // be as plausible as the hypotheses returned: the ambiguity is the building's, not a search
 // that missed. The lamp-pair index keeps this to tens of milliseconds (bench).
+// A generated office building of `nodes` nodes (the generator's defaults otherwise).
+graph::TopologicalMap generated_map(int nodes) {
+  sim::BuildingOptions bo;
+  bo.nodes = nodes;
+  return graph::parse_map(sim::generate_building(bo).geojson, "generated").map;
+}
+
 TEST(GlobalLocalizer, GeneratedBuildingFindsOrSaysAmbiguous) {
   const Museum m;  // for the robot
-  sim::BuildingOptions bo;
-  bo.nodes = 1000;
-  const sim::Building b = sim::generate_building(bo);
-  const graph::TopologicalMap map = graph::parse_map(b.geojson, "generated").map;
+  const graph::TopologicalMap map = generated_map(1000);
   std::vector<const graph::Node*> corridors;
   for (const auto& n : map.nodes())
     if (n.axis) corridors.push_back(&n);
@@ -281,10 +285,7 @@ TEST(GlobalLocalizer, GeneratedBuildingFindsOrSaysAmbiguous) {
 // corner from a crossing seen the other way round).
 TEST(GlobalLocalizer, ACrossingCannotPassForACorner) {
   const Museum m;  // for the robot
-  sim::BuildingOptions bo;
-  bo.nodes = 100;
-  const sim::Building b = sim::generate_building(bo);
-  const graph::TopologicalMap map = graph::parse_map(b.geojson, "generated").map;
+  const graph::TopologicalMap map = generated_map(100);
   const graph::Node *corner = nullptr, *crossing = nullptr;
   for (const auto& n : map.nodes()) {
     if (!corner && n.place == graph::Place::corner && !n.lamps.empty()) corner = &n;
