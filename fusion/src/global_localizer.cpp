@@ -190,6 +190,7 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     double theta, sigma, half_size;
     int lamp;
     bool crowded = false, matched = false;
+    bool covered = false;  // some blob lies over it (crowded lamps: seen, if merged)
   };
   std::vector<Predicted> pred;
   const Vector2d mount_xy = pose.transform_from(mount_t.head<2>());
@@ -224,16 +225,20 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
   };
   std::vector<Pair> pairs;
   std::vector<char> explained(blobs.size(), 0);
-  for (std::size_t i = 0; i < pred.size(); ++i)
+  for (std::size_t i = 0; i < pred.size(); ++i) {
+    const double reach = pred[i].half_size + 3 * pred[i].sigma;
     for (std::size_t j = 0; j < blobs.size(); ++j) {
       const double s2 =
           pred[i].sigma * pred[i].sigma + 0.25 * blobs[j].angular_radius * blobs[j].angular_radius;
-      const double d2 = (pred[i].ray - blobs[j].ray).squaredNorm() / s2;
+      const double chord2 = (pred[i].ray - blobs[j].ray).squaredNorm();
+      if (chord2 < reach * reach) pred[i].covered = true;
+      const double d2 = chord2 / s2;
       if (d2 <= 9.0) {
         explained[j] = 1;
         if (pred[i].theta <= max_theta) pairs.push_back({d2, int(i), int(j)});
       }
     }
+  }
   std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
     return a.cost < b.cost || (a.cost == b.cost && (a.p < b.p || (a.p == b.p && a.b < b.b)));
   });
@@ -255,12 +260,7 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
   for (const Predicted& p : pred) {
     if (!p.crowded || p.theta > expect_theta) continue;
     ++e.expected;
-    bool covered = p.matched;
-    for (std::size_t j = 0; j < blobs.size() && !covered; ++j) {
-      const double reach = p.half_size + 3 * p.sigma;
-      covered = (p.ray - blobs[j].ray).squaredNorm() < reach * reach;
-    }
-    if (!covered) ++e.missing;
+    if (!p.matched && !p.covered) ++e.missing;
   }
   for (std::size_t j = 0; j < blobs.size(); ++j)
     if (!b_used[j] && !explained[j]) ++e.unexplained;
