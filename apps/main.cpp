@@ -76,6 +76,17 @@ void add_bag_topic_options(CLI::App& command, io::BagTopics& topics) {
   command.add_option(
       "--odometry-topic", topics.odometry,
       "ROS 2 bag: the nav_msgs/msg/Odometry topic (default: the only one, or /odom)");
+  command.add_option("--joint-states-topic", topics.joint_states,
+                     "ROS 2 bag without odometry: the sensor_msgs/msg/JointState topic (default: "
+                     "the only one, or /joint_states)");
+  command.add_option("--left-joint", topics.left_joint,
+                     "ROS 2 bag: the left wheel's joint (default: the one named left)");
+  command.add_option("--right-joint", topics.right_joint,
+                     "ROS 2 bag: the right wheel's joint (default: the one named right)");
+  command
+      .add_option("--wheel-radius", topics.wheel_radius,
+                  "ROS 2 bag with wheel joints: the wheels' radius (m)")
+      ->check(CLI::PositiveNumber);
 }
 
 io::MissionLog read_log_for_robot(const std::string& log_path, const std::string& robot_path,
@@ -86,6 +97,13 @@ io::MissionLog read_log_for_robot(const std::string& log_path, const std::string
   if (log.ros2_bag) {
     for (const auto& n : log.notes) diagnostic("note", log_path + ": " + n);
     io::wheels_from_odometry(log, robot.semi_axis);
+    if (log.wheels.empty() && !log.wheel_joints.empty()) {
+      if (!(topics.wheel_radius > 0))
+        throw InputError({log_path, "topics", "--wheel-radius"},
+                         "the bag's wheel odometry is wheel joint angles "
+                         "(sensor_msgs/msg/JointState): give --wheel-radius");
+      io::wheels_from_joints(log, topics.wheel_radius);
+    }
   }
   return log;
 }

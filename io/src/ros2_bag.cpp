@@ -138,6 +138,48 @@ OdometryPose odometry(const std::string& data) {
   return o;
 }
 
+// sensor_msgs/msg/JointState: the positions of the two wheel joints, found by name.
+WheelJoints wheel_joints(const std::string& data, const std::string& left_name,
+                         const std::string& right_name) {
+  CdrReader r(data);
+  WheelJoints w;
+  w.stamp = header(r).stamp;
+  const std::vector<std::string> names = r.strings("name");
+  const std::vector<double> position = r.f64s("position");
+  if (position.size() != names.size())
+    throw CdrError("position holds " + std::to_string(position.size()) + " values for " +
+                   std::to_string(names.size()) + " names");
+  auto lower = [](std::string t) {
+    for (auto& c : t) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return t;
+  };
+  // Named, or the one joint whose name holds the side (a "wheel" one before others).
+  auto find = [&](const std::string& wanted, const char* side) -> std::size_t {
+    std::vector<std::size_t> hits, wheels;
+    for (std::size_t k = 0; k < names.size(); ++k) {
+      const bool hit =
+          !wanted.empty() ? names[k] == wanted : lower(names[k]).find(side) != std::string::npos;
+      if (!hit) continue;
+      hits.push_back(k);
+      if (lower(names[k]).find("wheel") != std::string::npos) wheels.push_back(k);
+    }
+    const auto& pick = wheels.size() == 1 ? wheels : hits;
+    if (pick.size() != 1) {
+      std::string all;
+      for (const auto& n : names) all += (all.empty() ? "" : ", ") + n;
+      throw CdrError(std::string("no single ") + side + " wheel joint among: " + all +
+                     " (name it with --" + side + "-joint)");
+    }
+    return pick.front();
+  };
+  const std::size_t l = find(left_name, "left"), rr = find(right_name, "right");
+  w.left = position[l];
+  w.right = position[rr];
+  if (!std::isfinite(w.left) || !std::isfinite(w.right))
+    throw CdrError("a wheel position is not finite");
+  return w;
+}
+
 CameraInfo camera_info(const std::string& data) {
   CdrReader r(data);
   CameraInfo c;
@@ -245,13 +287,35 @@ void read_ros2_messages(const McapFile& f, const std::string& path, const BagTop
          "\"fisheye\"); name them with --ceiling-topic and --omni-topic");
   if (ceiling && omni && ceiling == omni)
     fail("camera topics", "the ceiling and omni cameras cannot both be " + ceiling->topic);
-  if (!odom) log.notes.push_back("no nav_msgs/msg/Odometry topic: the bag gives no wheel odometry");
+  const McapChannel* joints = nullptr;
+  auto is_joint_state = [](const std::string& t) { return t == "sensor_msgs/JointState"; };
+  if (!wanted.joint_states.empty()) {
+    joints = named(wanted.joint_states, "joint states topic", is_joint_state);
+  } else if (!odom) {
+    std::vector<const McapChannel*> all;
+    for (const auto& ch : f.channels)
+      if (cdr(ch) && is_joint_state(type_of(f, ch))) all.push_back(&ch);
+    if (all.size() == 1) joints = all.front();
+    for (const auto* c : all)
+      if (all.size() > 1 && (c->topic == "/joint_states" || c->topic == "joint_states")) joints = c;
+    if (!joints && all.size() > 1)
+      fail("joint states topic",
+           "no odometry, and several sensor_msgs/msg/JointState topics; name one with "
+           "--joint-states-topic");
+  }
+  if (joints && !odom)
+    log.notes.push_back("wheel odometry from the wheel joints of " + joints->topic);
+  if (!odom && !joints)
+    log.notes.push_back(
+        "no nav_msgs/msg/Odometry or sensor_msgs/msg/JointState topic: the bag gives no wheel "
+        "odometry");
 
   // Decoded on every core, kept in file order.
   struct Decoded {
-    enum Kind { none, ceiling, omni, odometry, info, bad } kind = none;
+    enum Kind { none, ceiling, omni, odometry, joints, info, bad } kind = none;
     Logged<ImageFrame> image;
     Logged<OdometryPose> odo;
+    Logged<WheelJoints> wheel;
     CameraInfo info_value;
     std::string topic, problem;
   };
@@ -273,6 +337,9 @@ void read_ros2_messages(const McapFile& f, const std::string& path, const BagTop
       } else if (ch == odom) {
         d.odo = {avail, odometry(m.data)};
         d.kind = Decoded::odometry;
+      } else if (ch == joints && !odom) {
+        d.wheel = {avail, wheel_joints(m.data, wanted.left_joint, wanted.right_joint)};
+        d.kind = Decoded::joints;
       } else if (type == "sensor_msgs/CameraInfo") {
         d.info_value = camera_info(m.data);
         d.topic = ch->topic;
@@ -300,6 +367,9 @@ void read_ros2_messages(const McapFile& f, const std::string& path, const BagTop
         break;
       case Decoded::odometry:
         log.odometry.push_back(std::move(d.odo));
+        break;
+      case Decoded::joints:
+        log.wheel_joints.push_back(std::move(d.wheel));
         break;
       case Decoded::info:
         log.camera_info[d.topic] = std::move(d.info_value);
@@ -332,6 +402,26 @@ void wheels_from_odometry(MissionLog& log, double semi_axis) {
     left += ds - semi_axis * dyaw;
     right += ds + semi_axis * dyaw;
     log.wheels.push_back({odo[k].log_time, {odo[k].value.stamp, left, right}});
+  }
+}
+
+}  // namespace lampnav::io
+
+namespace lampnav::io {
+
+void wheels_from_joints(MissionLog& log, double wheel_radius) {
+  if (!log.wheels.empty() || log.wheel_joints.empty()) return;
+  auto joints = log.wheel_joints;
+  std::stable_sort(joints.begin(), joints.end(),
+                   [](const auto& a, const auto& b) { return a.value.stamp < b.value.stamp; });
+  const double l0 = joints.front().value.left, r0 = joints.front().value.right;
+  Stamp last;
+  for (const auto& j : joints) {
+    if (!log.wheels.empty() && !(j.value.stamp > last)) continue;
+    last = j.value.stamp;
+    log.wheels.push_back(
+        {j.log_time,
+         {j.value.stamp, wheel_radius * (j.value.left - l0), wheel_radius * (j.value.right - r0)}});
   }
 }
 

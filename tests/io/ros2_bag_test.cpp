@@ -185,6 +185,44 @@ TEST(Ros2Bag, OdometryBecomesWheelTravel) {
   EXPECT_EQ(log.wheels.size(), before.size());
 }
 
+// sensor_msgs/msg/JointState with these joints at these angles (rad).
+std::string joint_state_cdr(std::int64_t stamp_ns, const std::vector<std::string>& names,
+                            const std::vector<double>& position) {
+  CdrWriter w;
+  w.header(stamp_ns, "");
+  w.u32(static_cast<std::uint32_t>(names.size()));
+  for (const auto& n : names) w.string(n);
+  w.f64s(position).f64s({}).f64s({});
+  return w.data();
+}
+
+// Without odometry, the wheel joints: found by name, turned into travel by the wheel radius.
+TEST(Ros2Bag, WheelJointsBecomeWheelTravel) {
+  Bag bag;
+  bag.topics = {{"/joint_states", "sensor_msgs/msg/JointState"}};
+  const std::vector<std::string> names = {"caster_left", "left_wheel_joint", "right_wheel_joint"};
+  for (int k = 0; k < 20; ++k)
+    bag.messages.push_back({0, 1'000'000'000ULL + k * 20'000'000ULL,
+                            joint_state_cdr(1'000'000'000LL + k * 20'000'000LL, names,
+                                            {0.3, 2.0 + 0.1 * k, -1.0 + 0.12 * k})});
+  bag.messages.push_back(
+      {0, 2'000'000'000, joint_state_cdr(1'900'000'000, {"left_a", "left_b", "right"}, {1, 2, 3})});
+  const std::string path = bag.write("joints.mcap");
+  MissionLog log = read_mission_log(path);
+  std::filesystem::remove(path);
+  ASSERT_EQ(log.wheel_joints.size(), 20u);
+  EXPECT_EQ(log.skipped_messages, 1u);
+  ASSERT_FALSE(log.problems.empty());
+  EXPECT_THAT(log.problems.front(), HasSubstr("no single left wheel joint among: left_a, left_b"));
+  std::string notes;
+  for (const auto& n : log.notes) notes += n + "\n";
+  EXPECT_THAT(notes, HasSubstr("wheel joints of /joint_states"));
+  wheels_from_joints(log, 0.1);
+  ASSERT_EQ(log.wheels.size(), 20u);
+  EXPECT_NEAR(log.wheels.back().value.left, 0.1 * 0.1 * 19, 1e-12);
+  EXPECT_NEAR(log.wheels.back().value.right, 0.1 * 0.12 * 19, 1e-12);
+}
+
 TEST(Ros2Bag, TopicsNamedOrGuessedOrRefusedWithTheList) {
   const std::string png = encode_png(gradient(8, 8));
   Bag bag;

@@ -173,6 +173,16 @@ class MissionLogWriter {
 // guessed from the topic names and message types, and the guess said in MissionLog::notes.
 struct BagTopics {
   std::string ceiling_image, omni_image, odometry;
+  // sensor_msgs/msg/JointState, when the bag has no odometry: the topic and the two wheel
+  // joints (guessed: the one joint named left and the one named right, "wheel" preferred).
+  std::string joint_states, left_joint, right_joint;
+  double wheel_radius = 0;  // m: joint angles to wheel travel (robot.json does not hold it)
+};
+
+// sensor_msgs/msg/JointState's two wheel positions (rad).
+struct WheelJoints {
+  Stamp stamp;
+  double left = 0, right = 0;
 };
 
 // nav_msgs/msg/Odometry's pose: the robot base in its odometry frame.
@@ -195,6 +205,7 @@ struct CameraInfo {
 struct MissionLog {
   std::vector<Logged<WheelReading>> wheels;
   std::vector<Logged<OdometryPose>> odometry;     // a ROS 2 bag's (see wheels_from_odometry)
+  std::vector<Logged<WheelJoints>> wheel_joints;  // a ROS 2 bag's (see wheels_from_joints)
   std::map<std::string, CameraInfo> camera_info;  // by topic, the last of each
   std::vector<Logged<ImageFrame>> ceiling_images, omni_images;
   std::vector<Logged<TruthPose>> truth;
@@ -219,6 +230,9 @@ MissionLog read_mission_log(const std::string& path, const BagTopics& topics = {
 // pose, split between the two wheels of a differential drive with this semi-axis (m). Nothing is
 // done when the log has wheel readings of its own.
 void wheels_from_odometry(MissionLog& log, double semi_axis);
+// A bag's wheel joint positions (rad) as wheel travel (m) for wheels of this radius (m). Nothing
+// is done when the log has wheel readings of its own.
+void wheels_from_joints(MissionLog& log, double wheel_radius);
 
 // The truth of a log at any instant, interpolated between the samples around it. A kidnap is a
 // jump between two samples (more than 0.5 m): no interpolation across it.
