@@ -5,7 +5,9 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <random>
 
 #include "cdr_writer.hpp"
 #include "lampnav/core/error.hpp"
@@ -325,6 +327,63 @@ TEST(Ros2Bag, DamagedMessagesAreSkippedNamingTheField) {
   EXPECT_THAT(all, HasSubstr("encoding \"yuv422\" is not read"));
   EXPECT_THAT(all, HasSubstr("/odom message 0"));
   EXPECT_THAT(all, HasSubstr("sequence of 2147483647 elements"));
+}
+
+// Thousands of corrupted messages of every type (bytes flipped, cut short, counts and lengths
+// lying) in one bag: each is read or skipped with a reason, nothing else happens (run under the
+// sanitizers too).
+TEST(Ros2Bag, CorruptedMessagesAreReadOrSkippedNeverMore) {
+  const std::string png = encode_png(gradient(6, 5));
+  const Image8 g = gradient(6, 5);
+  CdrWriter info(true);
+  info.header(1, "c").u32(5).u32(6).string("plumb_bob").f64s({0.1, 0.2, 0, 0, 0});
+  for (int k = 0; k < 9 + 9 + 12; ++k) info.f64(k);
+  const std::vector<std::string> originals = {
+      test::compressed_image_cdr(1'000'000'000, "c", "png", png),
+      raw_image_cdr(g, "bgr8", 6 * 3 + 2, false), test::odometry_cdr(1'000'000'000, 1, 2, 0.5),
+      joint_state_cdr(1'000'000'000, {"left_wheel", "right_wheel"}, {1.0, 2.0}), info.data()};
+  Bag bag;
+  bag.topics = {{"/ceiling/image", "sensor_msgs/msg/CompressedImage"},
+                {"/omni/image", "sensor_msgs/msg/Image"},
+                {"/odom", "nav_msgs/msg/Odometry"},
+                {"/joint_states", "sensor_msgs/msg/JointState"},
+                {"/camera_info", "sensor_msgs/msg/CameraInfo"}};
+  std::mt19937_64 rng(7);
+  std::size_t sent = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const int topic = static_cast<int>(rng() % originals.size());
+    std::string m = originals[topic];
+    switch (rng() % 4) {
+      case 0:  // bytes flipped
+        for (int k = 0, n = 1 + static_cast<int>(rng() % 4); k < n; ++k)
+          m[rng() % m.size()] ^= static_cast<char>(1 + rng() % 255);
+        break;
+      case 1:  // cut short
+        m.resize(rng() % m.size());
+        break;
+      case 2: {  // a length or count lying (every aligned 4-byte word is one, perhaps)
+        const std::size_t at = 4 + 4 * (rng() % ((m.size() - 4) / 4));
+        const std::uint32_t lie =
+            rng() % 2 ? 0xFFFFFFFFu : static_cast<std::uint32_t>(rng() % 4096);
+        std::memcpy(&m[at], &lie, 4);
+        break;
+      }
+      default:  // garbage appended
+        m += std::string(rng() % 16, '\x7f');
+    }
+    bag.messages.push_back({topic, 1'000'000'000ULL + static_cast<std::uint64_t>(i), m});
+    ++sent;
+  }
+  const std::string path = bag.write("corrupt.mcap");
+  const MissionLog log = read_mission_log(path);
+  std::filesystem::remove(path);
+  const std::size_t read = log.ceiling_images.size() + log.omni_images.size() +
+                           log.odometry.size() + log.wheel_joints.size();
+  // Camera infos are kept by topic (the last one), so they are counted by what was skipped.
+  EXPECT_LE(read + log.skipped_messages, sent);
+  EXPECT_GT(log.skipped_messages, 500u);
+  EXPECT_EQ(log.problems.size(), log.skipped_messages);
+  for (const auto& p : log.problems) EXPECT_THAT(p, HasSubstr("(skipped)"));
 }
 
 }  // namespace
