@@ -197,6 +197,11 @@ struct Battery::Impl {
           r.unsure_s += took;
           ++r.unsure_frames;
           r.unsure_hypotheses += live;
+          if (live >= 50 && live <= 200) {
+            r.crowded_s += took;
+            ++r.crowded_frames;
+            r.crowded_hypotheses += live;
+          }
         }
         if (o.trace) o.trace(t, truth, loc);
         ++r.frames;
@@ -283,8 +288,8 @@ EpisodeResult Battery::unknown_start_at(const Pose2& start, std::uint64_t seed) 
 BatteryFigures figures(const std::vector<EpisodeResult>& rs) {
   BatteryFigures f;
   std::vector<double> lat_s, lat_m, past;
-  double unsure_s = 0;
-  std::size_t unsure_frames = 0, unsure_hyp = 0;
+  double unsure_s = 0, crowded_s = 0, all_s = 0;
+  std::size_t unsure_frames = 0, unsure_hyp = 0, crowded_hyp = 0, all_frames = 0;
   for (const auto& r : rs) {
     ++f.episodes;
     f.detected += r.detected;
@@ -295,6 +300,11 @@ BatteryFigures figures(const std::vector<EpisodeResult>& rs) {
     unsure_s += r.unsure_s;
     unsure_frames += r.unsure_frames;
     unsure_hyp += r.unsure_hypotheses;
+    crowded_s += r.crowded_s;
+    f.crowded_frames += r.crowded_frames;
+    crowded_hyp += r.crowded_hypotheses;
+    all_s += r.localizer_s;
+    all_frames += r.frames;
     if (r.fixed) {
       lat_s.push_back(r.latency_s);
       lat_m.push_back(r.latency_m);
@@ -321,6 +331,11 @@ BatteryFigures figures(const std::vector<EpisodeResult>& rs) {
     f.unsure_us_per_frame = 1e6 * unsure_s / unsure_frames;
     f.unsure_mean_hypotheses = double(unsure_hyp) / unsure_frames;
   }
+  if (f.crowded_frames) {
+    f.crowded_us_per_frame = 1e6 * crowded_s / f.crowded_frames;
+    f.crowded_mean_hypotheses = double(crowded_hyp) / f.crowded_frames;
+  }
+  if (all_frames) f.amortized_us_per_frame = 1e6 * all_s / all_frames;
   return f;
 }
 
