@@ -134,9 +134,8 @@ std::vector<int> GlobalLocalizer::Impl::lamps_in_view(const Pose2& pose, double 
     for (std::size_t i = 0; i < lamps.size(); ++i) out[i] = static_cast<int>(i);
     return out;
   }
-  for (const graph::Lamp* l :
-       map->lamps_within(pose.translation(), radius > 0 ? radius : view_radius))
-    out.push_back(lamp_index.at(l));
+  map->visit_lamps_within(pose.translation(), radius > 0 ? radius : view_radius,
+                          [&](const graph::Lamp& l) { out.push_back(lamp_index.at(&l)); });
   std::sort(out.begin(), out.end());  // the map's order, so that results do not depend on the index
   return out;
 }

@@ -243,6 +243,15 @@ std::vector<const Lamp*> TopologicalMap::lamps_within(const Eigen::Vector2d& p,
   return out;
 }
 
+void TopologicalMap::visit_lamps_within(const Eigen::Vector2d& p, double radius,
+                                        const std::function<void(const Lamp&)>& visit) const {
+  const Eigen::Vector2d r(radius, radius);
+  impl_->lamp_index.query(Box2{p - r, p + r}, [&](std::size_t i) {
+    const Lamp& l = impl_->lamp(impl_->lamps[i]);
+    if ((l.xyz.head<2>() - p).squaredNorm() <= radius * radius) visit(l);
+  });
+}
+
 std::vector<const Lamp*> TopologicalMap::lamps_ahead(const Pose2& pose, double max_distance,
                                                      double lateral) const {
   std::vector<std::pair<double, const Lamp*>> ahead;

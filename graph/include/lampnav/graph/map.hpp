@@ -5,6 +5,7 @@
 // kept apart from vertex descriptors, which never leave the implementation.
 
 #include <Eigen/Core>
+#include <functional>
 #include <iterator>
 #include <memory>
 #include <optional>
@@ -167,6 +168,9 @@ class TopologicalMap {
                                        double lateral) const;
   // All lamps whose centre (x, y) lies within `radius` of p, nearest first.
   std::vector<const Lamp*> lamps_within(const Eigen::Vector2d& p, double radius) const;
+  // The same lamps, unsorted, each given to `visit` (for hot paths that order them their own way).
+  void visit_lamps_within(const Eigen::Vector2d& p, double radius,
+                          const std::function<void(const Lamp&)>& visit) const;
 
   // Implementation access for the graph module's algorithms (planner, checks).
   struct Impl;
