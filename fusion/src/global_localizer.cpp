@@ -7,6 +7,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -499,7 +500,9 @@ std::optional<PoseHypothesis> GlobalLocalizer::refine(const Pose2& predicted, do
   PoseHypothesis h = m.refine(predicted, position_sigma, yaw_sigma, blobs);
   if (h.matches.empty()) return std::nullopt;
   h.node = m.node_of(h.pose);
-  h.merit = m.paper_merit(h.pose, m.merit_function(d));
+  // The paper's merit is not computed here (a new merit function per call; callers weigh by
+  // score): locate() gives it.
+  h.merit = std::numeric_limits<double>::quiet_NaN();
   return h;
 }
 

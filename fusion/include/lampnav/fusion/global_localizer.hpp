@@ -113,7 +113,8 @@ struct GlobalLocalization {
 
 class GlobalLocalizer {
  public:
-  // Throws InputError for bad options, Error when the camera is not a fisheye one (pajdla_bakstein, kannala_brandt).
+  // Throws InputError for bad options, Error when the camera is not a fisheye one (pajdla_bakstein,
+  // kannala_brandt).
   GlobalLocalizer(const graph::TopologicalMap& map, const CameraDescription& omni_camera,
                   const GlobalLocalizerOptions& options = {});
   ~GlobalLocalizer();
@@ -144,7 +145,8 @@ class GlobalLocalizer {
 
   // The hypothesis near a predicted pose (one known within position_sigma and yaw_sigma, as
   // odometry carries a hypothesis to the next image): matched, refined and scored as the default
-  // method does. nullopt when no lamp matches.
+  // method does (its `merit` left NaN: locate() gives the paper's merit). nullopt when no lamp
+  // matches.
   std::optional<PoseHypothesis> refine(const Pose2& predicted, double position_sigma,
                                        double yaw_sigma,
                                        const vision::OmniDetection& detection) const;
