@@ -3,13 +3,13 @@
 // wheels, each camera's mount).
 
 #include <CLI/CLI.hpp>
-#include <fstream>
 #include <iostream>
 #include <map>
 #include <memory>
 
 #include "commands.hpp"
 #include "lampnav/core/error.hpp"
+#include "lampnav/internal/json_util.hpp"
 #include "lampnav/io/calibration.hpp"
 
 namespace lampnav::apps {
@@ -19,18 +19,6 @@ struct ImportArgs {
   std::vector<std::string> calibrations;
   std::string robot, out, camera;
 };
-
-const char* model_name(CameraModelKind k) {
-  switch (k) {
-    case CameraModelKind::pinhole:
-      return "pinhole";
-    case CameraModelKind::pajdla_bakstein:
-      return "pajdla_bakstein";
-    case CameraModelKind::kannala_brandt:
-      return "kannala_brandt";
-  }
-  return "?";
-}
 
 int run_import(const ImportArgs& a) {
   RobotDescription robot = read_robot_description(a.robot);
@@ -62,20 +50,17 @@ int run_import(const ImportArgs& a) {
       throw InputError({path, ic.label, "distortion_model"},
                        "the ceiling camera must be a pinhole camera (its pipeline needs one), "
                        "this calibration is " +
-                           std::string(model_name(ic.camera.model)));
+                           std::string(to_string(ic.camera.model)));
     ic.camera.name = target->name;
     ic.camera.mount = target->mount;
-    std::cout << name << ": " << model_name(target->model) << " " << target->width << " x "
-              << target->height << " -> " << model_name(ic.camera.model) << " " << ic.camera.width
+    std::cout << name << ": " << to_string(target->model) << " " << target->width << " x "
+              << target->height << " -> " << to_string(ic.camera.model) << " " << ic.camera.width
               << " x " << ic.camera.height << " from " << from << " (" << ic.format << ")\n";
     *target = ic.camera;
   }
   const std::string text = to_robot_json(robot);
   parse_robot_description(text, a.out);  // what is written reads back
-  std::ofstream out(a.out, std::ios::binary);
-  if (!out) throw InputError({a.out, "", ""}, "cannot write the file");
-  out << text;
-  if (!out.flush()) throw InputError({a.out, "", ""}, "cannot write the file");
+  json::write_file(a.out, text);
   std::cout << "wrote " << a.out << "\n";
   return 0;
 }

@@ -43,9 +43,9 @@ void report(benchmark::State& state, const test::BatteryFigures& f) {
   state.counters["max_hypotheses"] = static_cast<double>(f.max_hypotheses);
   state.counters["unsure_us_per_frame"] = f.unsure_us_per_frame;
   state.counters["unsure_mean_hypotheses"] = f.unsure_mean_hypotheses;
-  state.counters["us_per_frame_50_200_hypotheses"] = f.crowded_us_per_frame;
-  state.counters["frames_50_200_hypotheses"] = static_cast<double>(f.crowded_frames);
-  state.counters["mean_hypotheses_of_those"] = f.crowded_mean_hypotheses;
+  state.counters["us_per_frame_50_200_hypotheses"] = f.many_us_per_frame;
+  state.counters["frames_50_200_hypotheses"] = static_cast<double>(f.many_frames);
+  state.counters["mean_hypotheses_of_those"] = f.many_mean_hypotheses;
   state.counters["amortized_us_per_frame"] = f.amortized_us_per_frame;
   state.counters["oracle_decided"] = f.oracle_decided;
   state.counters["within_oracle_10m"] = f.within_oracle_10m;

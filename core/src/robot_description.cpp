@@ -46,6 +46,14 @@ int read_size(const Cursor& c) {
   return static_cast<int>(v);
 }
 
+// A fisheye's optional field of view (else its model's default).
+void read_fov(const Cursor& c, FisheyeParameters& f) {
+  if (auto fov = c.find("fov_deg")) {
+    f.fov_deg = fov->positive();
+    if (f.fov_deg >= 360.0) fov->fail("must be below 360 degrees");
+  }
+}
+
 CameraDescription read_camera(const Cursor& c) {
   c.expect_object();
   CameraDescription cam;
@@ -81,10 +89,7 @@ CameraDescription read_camera(const Cursor& c) {
     if (f.b == 0.0) c.at("b").fail("must not be zero (r = a tan(theta / b) + ...)");
     if (f.d == 0.0) c.at("d").fail("must not be zero (r = ... + c sin(theta / d))");
     if (auto beta = c.find("beta")) f.beta = beta->positive();
-    if (auto fov = c.find("fov_deg")) {
-      f.fov_deg = fov->positive();
-      if (f.fov_deg >= 360.0) fov->fail("must be below 360 degrees");
-    }
+    read_fov(c, f);
   } else if (model == "kannala_brandt") {
     c.only_keys(
         {"name", "model", "width", "height", "fx", "fy", "cx", "cy", "k", "fov_deg", "mount"});
@@ -98,10 +103,7 @@ CameraDescription read_camera(const Cursor& c) {
     k.array_size(4, 4);
     for (std::size_t i = 0; i < 4; ++i) f.k[i] = k[i].number();
     f.fov_deg = 180.0;
-    if (auto fov = c.find("fov_deg")) {
-      f.fov_deg = fov->positive();
-      if (f.fov_deg >= 360.0) fov->fail("must be below 360 degrees");
-    }
+    read_fov(c, f);
   } else {
     c.at("model").fail("unknown camera model '" + model +
                        "' (expected pinhole, pajdla_bakstein or kannala_brandt)");
@@ -110,6 +112,18 @@ CameraDescription read_camera(const Cursor& c) {
 }
 
 }  // namespace
+
+const char* to_string(CameraModelKind k) {
+  switch (k) {
+    case CameraModelKind::pinhole:
+      return "pinhole";
+    case CameraModelKind::pajdla_bakstein:
+      return "pajdla_bakstein";
+    case CameraModelKind::kannala_brandt:
+      return "kannala_brandt";
+  }
+  return "?";
+}
 
 RobotDescription parse_robot_description(const std::string& text, const std::string& source) {
   const Json doc = json::parse(text, source);
@@ -155,7 +169,7 @@ std::string to_robot_json(const RobotDescription& robot) {
     cj["width"] = c.width;
     cj["height"] = c.height;
     if (c.model == CameraModelKind::pinhole) {
-      cj["model"] = "pinhole";
+      cj["model"] = to_string(c.model);
       cj["fx"] = c.pinhole.fx;
       cj["fy"] = c.pinhole.fy;
       cj["cx"] = c.pinhole.cx;
@@ -163,7 +177,7 @@ std::string to_robot_json(const RobotDescription& robot) {
       cj["distortion"] = c.pinhole.distortion;
     } else if (c.model == CameraModelKind::kannala_brandt) {
       const auto& f = c.fisheye;
-      cj["model"] = "kannala_brandt";
+      cj["model"] = to_string(c.model);
       cj["fx"] = f.f;
       cj["fy"] = f.f * f.beta;
       cj["cx"] = f.u0;
@@ -172,7 +186,7 @@ std::string to_robot_json(const RobotDescription& robot) {
       cj["fov_deg"] = f.fov_deg;
     } else {
       const auto& f = c.fisheye;
-      cj["model"] = "pajdla_bakstein";
+      cj["model"] = to_string(c.model);
       cj["u0"] = f.u0;
       cj["v0"] = f.v0;
       cj["a"] = f.a;

@@ -252,15 +252,12 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     e.cost += p.cost;
     e.matches.emplace_back(pred[p.p].lamp, p.b);
   }
+  // A lamp in clear view is missing when no blob matched it; one crowded by its neighbours only
+  // when no blob lies over it either.
   for (const Predicted& p : pred) {
-    if (p.crowded || p.theta > expect_theta) continue;
+    if (p.theta > expect_theta) continue;
     ++e.expected;
-    if (!p.matched) ++e.missing;
-  }
-  for (const Predicted& p : pred) {
-    if (!p.crowded || p.theta > expect_theta) continue;
-    ++e.expected;
-    if (!p.matched && !p.covered) ++e.missing;
+    if (!p.matched && !(p.crowded && p.covered)) ++e.missing;
   }
   for (std::size_t j = 0; j < blobs.size(); ++j)
     if (!b_used[j] && !explained[j]) ++e.unexplained;

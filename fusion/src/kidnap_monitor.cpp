@@ -53,7 +53,7 @@ OmniCheck::OmniCheck(const graph::TopologicalMap& map, const CameraDescription& 
     for (const auto& l : n.lamps) {
       lamps_.push_back(&l);
       smallest = std::min({smallest, l.length, l.width > 0 ? l.width : l.length});
-      highest = std::max(highest, l.xyz.z() - (camera.mount.xyz.z()));
+      highest = std::max(highest, l.xyz.z() - mount_t_.z());
     }
   if (highest > 0 && smallest < 1e9) min_blob_per_cos_ = 0.25 * smallest / highest;
 }

@@ -228,12 +228,8 @@ Travel TopologicalMap::travel_for_heading(NodeId id, double heading) const {
 std::vector<const Lamp*> TopologicalMap::lamps_within(const Eigen::Vector2d& p,
                                                       double radius) const {
   std::vector<std::pair<double, const Lamp*>> hits;
-  const Eigen::Vector2d r(radius, radius);
-  impl_->lamp_index.query(Box2{p - r, p + r}, [&](std::size_t i) {
-    const Lamp& l = impl_->lamp(impl_->lamps[i]);
-    const double d = (l.xyz.head<2>() - p).norm();
-    if (d <= radius) hits.emplace_back(d, &l);
-  });
+  visit_lamps_within(p, radius,
+                     [&](const Lamp& l) { hits.emplace_back((l.xyz.head<2>() - p).norm(), &l); });
   std::sort(hits.begin(), hits.end(), [](const auto& a, const auto& b) {
     return a.first < b.first || (a.first == b.first && a.second->id < b.second->id);
   });

@@ -3,12 +3,12 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
-#include <fstream>
 #include <map>
 #include <opencv2/core.hpp>
 #include <sstream>
 
 #include "lampnav/core/error.hpp"
+#include "lampnav/internal/json_util.hpp"
 
 namespace lampnav::io {
 
@@ -192,18 +192,10 @@ CameraDescription camera(const std::string& model, const std::vector<double>& d,
   return c;
 }
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError({path, "", ""}, "cannot open the file");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 }  // namespace
 
 std::vector<ImportedCamera> read_calibration(const std::string& path) {
-  const std::string data = slurp(path);
+  const std::string data = json::read_file(path);
   Node root;
   const bool opencv = data.rfind("%YAML:1.", 0) == 0 ||
                       (data.find("<?xml") != std::string::npos && data.find("<?xml") < 16);

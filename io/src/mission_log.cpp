@@ -13,7 +13,7 @@
 #include <stdexcept>
 
 #include "lampnav/core/error.hpp"
-#include "parallel.hpp"
+#include "lampnav/core/parallel.hpp"
 
 namespace lampnav::io {
 
@@ -414,6 +414,90 @@ ImageFrame image(const Json& j) {
   return f;
 }
 
+// One message of lampnav's own JSON channels.
+void decode_json(const McapChannel& ch, const McapMessage& m, DecodedMessage& d) {
+  using Kind = DecodedMessage::Kind;
+  const std::string& topic = ch.topic;
+  const bool input = topic == topics::kWheels || topic == topics::kCeilingImage ||
+                     topic == topics::kOmniImage || topic == topics::kTruth ||
+                     topic == topics::kEvents || topic == topics::kCommands;
+  // Other topics (a replay's own outputs, a user's extras) are not inputs: left alone.
+  if (!input) return;
+  const Stamp avail = stamp_from_nanoseconds(static_cast<std::int64_t>(m.log_time));
+  try {
+    Json j;
+    try {
+      j = Json::parse(m.data);
+    } catch (const Json::parse_error& e) {
+      throw BadMessage(std::string("bad JSON: ") + e.what());
+    }
+    if (!j.is_object()) throw BadMessage("not a JSON object");
+    if (topic == topics::kWheels) {
+      d.wheel = {avail, {stamp(j), number(j, "left"), number(j, "right")}};
+      d.kind = Kind::wheels;
+    } else if (topic == topics::kCeilingImage || topic == topics::kOmniImage) {
+      d.image = {avail, image(j)};
+      d.kind = topic == topics::kCeilingImage ? Kind::ceiling : Kind::omni;
+    } else if (topic == topics::kTruth) {
+      const Json& pose = member(j, "pose");
+      const Json& p = member(pose, "position");
+      const Json& q = member(pose, "orientation");
+      const double yaw = 2.0 * std::atan2(number(q, "z"), number(q, "w"));
+      d.truth = {avail, {stamp(j), Pose2(number(p, "x"), number(p, "y"), yaw)}};
+      d.kind = Kind::truth;
+    } else if (topic == topics::kEvents) {
+      d.event = {avail, {stamp(j), text(j, "kind"), j.contains("detail") ? text(j, "detail") : ""}};
+      d.kind = Kind::event;
+    } else {
+      d.command = {avail, {stamp(j), text(j, "text")}};
+      d.kind = Kind::command;
+    }
+  } catch (const BadMessage& e) {
+    d.kind = Kind::bad;
+    d.problem = skipped(ch, m, e.what());
+  }
+}
+
+// A decoded message into its place in the log.
+void keep(DecodedMessage& d, MissionLog& log) {
+  using Kind = DecodedMessage::Kind;
+  switch (d.kind) {
+    case Kind::wheels:
+      log.wheels.push_back(std::move(d.wheel));
+      break;
+    case Kind::ceiling:
+      log.ceiling_images.push_back(std::move(d.image));
+      break;
+    case Kind::omni:
+      log.omni_images.push_back(std::move(d.image));
+      break;
+    case Kind::truth:
+      log.truth.push_back(std::move(d.truth));
+      break;
+    case Kind::event:
+      log.events.push_back(std::move(d.event));
+      break;
+    case Kind::command:
+      log.commands.push_back(std::move(d.command));
+      break;
+    case Kind::odometry:
+      log.odometry.push_back(std::move(d.odometry));
+      break;
+    case Kind::joints:
+      log.wheel_joints.push_back(std::move(d.joints));
+      break;
+    case Kind::camera_info:
+      log.camera_info[d.topic] = std::move(*d.camera_info);
+      break;
+    case Kind::bad:
+      ++log.skipped_messages;
+      log.problems.push_back(std::move(d.problem));
+      break;
+    case Kind::none:
+      break;
+  }
+}
+
 }  // namespace
 
 MissionLog read_mission_log(const std::string& path, const BagTopics& bag_topics) {
@@ -422,96 +506,24 @@ MissionLog read_mission_log(const std::string& path, const BagTopics& bag_topics
   log.report = f.report;
   if (const auto* a = f.attachment("robot.json")) log.robot_json = a->data;
   if (const auto* a = f.attachment("map.geojson")) log.map_geojson = a->data;
-  // Each message decoded on its own (JSON, base64: most of the time on image logs), on every
-  // core, then kept in the file's order.
-  struct Decoded {
-    enum Kind { none, wheels, ceiling, omni, truth, event, command, bad } kind = none;
-    Logged<WheelReading> wheel;
-    Logged<ImageFrame> image;
-    Logged<TruthPose> pose;
-    Logged<MissionEvent> event_value;
-    Logged<CommandMessage> command_value;
-    std::string problem;
-  };
-  std::vector<Decoded> decoded(f.messages.size());
-  auto decode = [&](std::size_t i) {
+  // A ROS 2 bag's input channels are chosen once, before its messages are decoded.
+  log.ros2_bag = std::any_of(f.channels.begin(), f.channels.end(),
+                             [](const McapChannel& c) { return c.message_encoding == "cdr"; });
+  Ros2Channels ros2;
+  if (log.ros2_bag) ros2 = choose_ros2_channels(f, path, bag_topics, log.notes);
+  // Each message decoded on its own (JSON and base64, or CDR and pixels: most of the time on
+  // image logs), on every core, then kept in the file's order.
+  std::vector<DecodedMessage> decoded(f.messages.size());
+  for_each_index(decoded.size(), [&](std::size_t i) {
     const McapMessage& m = f.messages[i];
     const McapChannel* ch = f.channel(m.channel_id);
-    const Stamp avail = stamp_from_nanoseconds(static_cast<std::int64_t>(m.log_time));
-    Decoded& d = decoded[i];
-    const std::string& topic = ch->topic;
-    const bool input = topic == topics::kWheels || topic == topics::kCeilingImage ||
-                       topic == topics::kOmniImage || topic == topics::kTruth ||
-                       topic == topics::kEvents || topic == topics::kCommands;
-    // Other topics (a replay's own outputs, a user's extras) are not inputs: left alone.
-    if (!input) return;
-    try {
-      Json j;
-      try {
-        j = Json::parse(m.data);
-      } catch (const Json::parse_error& e) {
-        throw BadMessage(std::string("bad JSON: ") + e.what());
-      }
-      if (!j.is_object()) throw BadMessage("not a JSON object");
-      if (topic == topics::kWheels) {
-        d.wheel = {avail, {stamp(j), number(j, "left"), number(j, "right")}};
-        d.kind = Decoded::wheels;
-      } else if (topic == topics::kCeilingImage || topic == topics::kOmniImage) {
-        d.image = {avail, image(j)};
-        d.kind = topic == topics::kCeilingImage ? Decoded::ceiling : Decoded::omni;
-      } else if (topic == topics::kTruth) {
-        const Json& pose = member(j, "pose");
-        const Json& p = member(pose, "position");
-        const Json& q = member(pose, "orientation");
-        const double yaw = 2.0 * std::atan2(number(q, "z"), number(q, "w"));
-        d.pose = {avail, {stamp(j), Pose2(number(p, "x"), number(p, "y"), yaw)}};
-        d.kind = Decoded::truth;
-      } else if (topic == topics::kEvents) {
-        d.event_value = {
-            avail, {stamp(j), text(j, "kind"), j.contains("detail") ? text(j, "detail") : ""}};
-        d.kind = Decoded::event;
-      } else {
-        d.command_value = {avail, {stamp(j), text(j, "text")}};
-        d.kind = Decoded::command;
-      }
-    } catch (const BadMessage& e) {
-      d.kind = Decoded::bad;
-      d.problem =
-          ch->topic + " message " + std::to_string(m.sequence) + ": " + e.what() + " (skipped)";
-    }
-  };
-  for_each_index(decoded.size(), decode);
-  for (auto& d : decoded) {
-    switch (d.kind) {
-      case Decoded::wheels:
-        log.wheels.push_back(std::move(d.wheel));
-        break;
-      case Decoded::ceiling:
-        log.ceiling_images.push_back(std::move(d.image));
-        break;
-      case Decoded::omni:
-        log.omni_images.push_back(std::move(d.image));
-        break;
-      case Decoded::truth:
-        log.truth.push_back(std::move(d.pose));
-        break;
-      case Decoded::event:
-        log.events.push_back(std::move(d.event_value));
-        break;
-      case Decoded::command:
-        log.commands.push_back(std::move(d.command_value));
-        break;
-      case Decoded::bad:
-        ++log.skipped_messages;
-        log.problems.push_back(std::move(d.problem));
-        break;
-      case Decoded::none:
-        break;
-    }
-  }
-  const bool bag = std::any_of(f.channels.begin(), f.channels.end(),
-                               [](const McapChannel& c) { return c.message_encoding == "cdr"; });
-  if (bag) read_ros2_messages(f, path, bag_topics, log);
+    if (!ch) return;
+    if (ch->message_encoding == "cdr")
+      decode_ros2(ros2, *ch, m, decoded[i]);
+    else
+      decode_json(*ch, m, decoded[i]);
+  });
+  for (auto& d : decoded) keep(d, log);
   return log;
 }
 

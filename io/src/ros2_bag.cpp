@@ -6,7 +6,6 @@
 
 #include "cdr.hpp"
 #include "lampnav/core/error.hpp"
-#include "parallel.hpp"
 
 namespace lampnav::io {
 
@@ -19,6 +18,11 @@ std::string type_of(const McapFile& f, const McapChannel& ch) {
   std::string name = s->name;
   if (const auto p = name.find("/msg/"); p != std::string::npos) name.erase(p, 4);
   return name;
+}
+
+std::string lower(std::string t) {
+  for (auto& c : t) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return t;
 }
 
 bool is_image(const std::string& type) {
@@ -96,6 +100,7 @@ ImageFrame raw_image(const std::string& data) {
   if (std::uint64_t(step) * height > pixels.size())
     throw CdrError("data holds " + std::to_string(pixels.size()) + " bytes, step x height is " +
                    std::to_string(std::uint64_t(step) * height));
+  const bool rgb = encoding[0] == 'r';
   Image8 grey(static_cast<int>(width), static_cast<int>(height));
   for (std::uint32_t y = 0; y < height; ++y) {
     const auto* in = reinterpret_cast<const unsigned char*>(pixels.data()) + std::size_t(y) * step;
@@ -109,7 +114,6 @@ ImageFrame raw_image(const std::string& data) {
         out[x] = p[0];
       } else {
         // ITU-R 601 luma, as OpenCV's colour conversion.
-        const bool rgb = encoding[0] == 'r';
         const double b = rgb ? p[2] : p[0], g = p[1], rr = rgb ? p[0] : p[2];
         out[x] = static_cast<std::uint8_t>(std::lround(0.114 * b + 0.587 * g + 0.299 * rr));
       }
@@ -149,10 +153,6 @@ WheelJoints wheel_joints(const std::string& data, const std::string& left_name,
   if (position.size() != names.size())
     throw CdrError("position holds " + std::to_string(position.size()) + " values for " +
                    std::to_string(names.size()) + " names");
-  auto lower = [](std::string t) {
-    for (auto& c : t) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return t;
-  };
   // Named, or the one joint whose name holds the side (a "wheel" one before others).
   auto find = [&](const std::string& wanted, const char* side) -> std::size_t {
     std::vector<std::size_t> hits, wheels;
@@ -201,7 +201,7 @@ std::string topic_list(const McapFile& f, const std::vector<std::size_t>& counts
   bool first = true;
   for (const auto& ch : f.channels) {
     s << (first ? "" : ", ") << ch.topic << " (" << type_of(f, ch) << ", "
-      << counts[&ch - f.channels.data()] << " messages)";
+      << counts[std::size_t(&ch - f.channels.data())] << " messages)";
     first = false;
   }
   return s.str();
@@ -209,8 +209,17 @@ std::string topic_list(const McapFile& f, const std::vector<std::size_t>& counts
 
 }  // namespace
 
-void read_ros2_messages(const McapFile& f, const std::string& path, const BagTopics& wanted,
-                        MissionLog& log) {
+Ros2Channels choose_ros2_channels(const McapFile& f, const std::string& path,
+                                  const BagTopics& wanted, std::vector<std::string>& notes) {
+  Ros2Channels c;
+  c.left_joint = wanted.left_joint;
+  c.right_joint = wanted.right_joint;
+  for (const auto& ch : f.channels)
+    if (ch.message_encoding == "cdr") c.types[ch.id] = type_of(f, ch);
+  auto type = [&](const McapChannel& ch) -> std::string {
+    const auto it = c.types.find(ch.id);
+    return it == c.types.end() ? std::string() : it->second;
+  };
   std::vector<std::size_t> counts(f.channels.size(), 0);
   std::map<std::uint16_t, std::size_t> index;
   for (std::size_t k = 0; k < f.channels.size(); ++k) index[f.channels[k].id] = k;
@@ -219,176 +228,132 @@ void read_ros2_messages(const McapFile& f, const std::string& path, const BagTop
   auto fail = [&](const std::string& field, const std::string& what) {
     throw InputError({path, "topics", field}, what + "; the bag has: " + topic_list(f, counts));
   };
-  auto cdr = [](const McapChannel& ch) { return ch.message_encoding == "cdr"; };
   // The channel of a topic given by name: it must be there, with a type that fits.
   auto named = [&](const std::string& topic, const char* field, auto fits) -> const McapChannel* {
     const McapChannel* ch = f.channel(topic);
-    if (!ch || !cdr(*ch)) fail(field, "no CDR topic \"" + topic + "\"");
-    if (!fits(type_of(f, *ch)))
-      fail(field, "\"" + topic + "\" is a " + type_of(f, *ch) + ", not what " + field + " needs");
+    if (!ch || type(*ch).empty()) fail(field, "no CDR topic \"" + topic + "\"");
+    if (!fits(type(*ch)))
+      fail(field, "\"" + topic + "\" is a " + type(*ch) + ", not what " + field + " needs");
     return ch;
   };
   // Guessed: the image topics whose name says the camera, a compressed one before a raw one.
   auto guess_camera = [&](std::initializer_list<const char*> words) -> const McapChannel* {
-    std::vector<const McapChannel*> found;
+    std::vector<const McapChannel*> found, compressed;
     for (const auto& ch : f.channels) {
-      if (!cdr(ch) || !is_image(type_of(f, ch))) continue;
-      std::string t = ch.topic;
-      std::transform(t.begin(), t.end(), t.begin(),
-                     [](unsigned char c) { return std::tolower(c); });
-      for (const char* w : words)
-        if (t.find(w) != std::string::npos) {
-          found.push_back(&ch);
-          break;
-        }
+      if (!is_image(type(ch))) continue;
+      const std::string t = lower(ch.topic);
+      if (std::none_of(words.begin(), words.end(),
+                       [&](const char* w) { return t.find(w) != std::string::npos; }))
+        continue;
+      found.push_back(&ch);
+      if (type(ch) == "sensor_msgs/CompressedImage") compressed.push_back(&ch);
     }
-    const auto compressed = std::count_if(found.begin(), found.end(), [&](const McapChannel* c) {
-      return type_of(f, *c) == "sensor_msgs/CompressedImage";
-    });
-    if (compressed >= 1)
-      found.erase(std::remove_if(found.begin(), found.end(),
-                                 [&](const McapChannel* c) {
-                                   return type_of(f, *c) != "sensor_msgs/CompressedImage";
-                                 }),
-                  found.end());
-    return found.size() == 1 ? found.front() : nullptr;
+    const auto& pick = compressed.empty() ? found : compressed;
+    return pick.size() == 1 ? pick.front() : nullptr;
   };
-
-  const McapChannel *ceiling = nullptr, *omni = nullptr, *odom = nullptr;
-  if (!wanted.ceiling_image.empty())
-    ceiling = named(wanted.ceiling_image, "ceiling camera topic", is_image);
-  else if ((ceiling = guess_camera({"ceiling"})))
-    log.notes.push_back("ceiling camera images from " + ceiling->topic + " (by its name)");
-  if (!wanted.omni_image.empty())
-    omni = named(wanted.omni_image, "omni camera topic", is_image);
-  else if ((omni = guess_camera({"omni", "fisheye", "panoram", "360"})))
-    log.notes.push_back("omni camera images from " + omni->topic + " (by its name)");
-  auto is_odometry = [](const std::string& t) { return t == "nav_msgs/Odometry"; };
-  if (!wanted.odometry.empty()) {
-    odom = named(wanted.odometry, "odometry topic", is_odometry);
-  } else {
+  // The one channel of a type, or among several the one with the usual name.
+  auto only = [&](const char* of_type, const std::string& usual, const char* field,
+                  const std::string& several) -> const McapChannel* {
     std::vector<const McapChannel*> all;
     for (const auto& ch : f.channels)
-      if (cdr(ch) && is_odometry(type_of(f, ch))) all.push_back(&ch);
-    if (all.size() == 1) odom = all.front();
-    for (const auto* c : all)
-      if (all.size() > 1 && (c->topic == "/odom" || c->topic == "odom")) odom = c;
-    if (odom)
-      log.notes.push_back("wheel odometry from " + odom->topic);
-    else if (all.size() > 1)
-      fail("odometry topic",
-           "several nav_msgs/msg/Odometry topics; name one with --odometry-topic");
+      if (type(ch) == of_type) all.push_back(&ch);
+    if (all.size() == 1) return all.front();
+    for (const auto* ch : all)
+      if (ch->topic == usual || "/" + ch->topic == usual) return ch;
+    if (all.size() > 1) fail(field, several);
+    return nullptr;
+  };
+
+  if (!wanted.ceiling_image.empty())
+    c.ceiling = named(wanted.ceiling_image, "ceiling camera topic", is_image);
+  else if ((c.ceiling = guess_camera({"ceiling"})))
+    notes.push_back("ceiling camera images from " + c.ceiling->topic + " (by its name)");
+  if (!wanted.omni_image.empty())
+    c.omni = named(wanted.omni_image, "omni camera topic", is_image);
+  else if ((c.omni = guess_camera({"omni", "fisheye", "panoram", "360"})))
+    notes.push_back("omni camera images from " + c.omni->topic + " (by its name)");
+  auto is_odometry = [](const std::string& t) { return t == "nav_msgs/Odometry"; };
+  auto is_joint_state = [](const std::string& t) { return t == "sensor_msgs/JointState"; };
+  if (!wanted.odometry.empty()) {
+    c.odometry = named(wanted.odometry, "odometry topic", is_odometry);
+  } else if (!wanted.joint_states.empty()) {
+    c.joints = named(wanted.joint_states, "joint states topic", is_joint_state);
+  } else {
+    c.odometry = only("nav_msgs/Odometry", "/odom", "odometry topic",
+                      "several nav_msgs/msg/Odometry topics; name one with --odometry-topic");
+    if (!c.odometry)
+      c.joints = only("sensor_msgs/JointState", "/joint_states", "joint states topic",
+                      "no odometry, and several sensor_msgs/msg/JointState topics; name one with "
+                      "--joint-states-topic");
   }
-  bool images = false;
-  for (const auto& ch : f.channels) images = images || (cdr(ch) && is_image(type_of(f, ch)));
-  if (images && !ceiling && !omni)
+  const bool images =
+      std::any_of(c.types.begin(), c.types.end(), [](const auto& t) { return is_image(t.second); });
+  if (images && !c.ceiling && !c.omni)
     fail("camera topics",
          "cannot tell which image topic is which camera (no name says \"ceiling\", \"omni\" or "
          "\"fisheye\"); name them with --ceiling-topic and --omni-topic");
-  if (ceiling && omni && ceiling == omni)
-    fail("camera topics", "the ceiling and omni cameras cannot both be " + ceiling->topic);
-  const McapChannel* joints = nullptr;
-  auto is_joint_state = [](const std::string& t) { return t == "sensor_msgs/JointState"; };
-  if (!wanted.joint_states.empty()) {
-    joints = named(wanted.joint_states, "joint states topic", is_joint_state);
-  } else if (!odom) {
-    std::vector<const McapChannel*> all;
-    for (const auto& ch : f.channels)
-      if (cdr(ch) && is_joint_state(type_of(f, ch))) all.push_back(&ch);
-    if (all.size() == 1) joints = all.front();
-    for (const auto* c : all)
-      if (all.size() > 1 && (c->topic == "/joint_states" || c->topic == "joint_states")) joints = c;
-    if (!joints && all.size() > 1)
-      fail("joint states topic",
-           "no odometry, and several sensor_msgs/msg/JointState topics; name one with "
-           "--joint-states-topic");
-  }
-  if (joints && !odom)
-    log.notes.push_back("wheel odometry from the wheel joints of " + joints->topic);
-  if (!odom && !joints)
-    log.notes.push_back(
+  if (c.ceiling && c.ceiling == c.omni)
+    fail("camera topics", "the ceiling and omni cameras cannot both be " + c.ceiling->topic);
+
+  if (c.odometry)
+    notes.push_back("wheel odometry from " + c.odometry->topic);
+  else if (c.joints)
+    notes.push_back("wheel odometry from the wheel joints of " + c.joints->topic);
+  else
+    notes.push_back(
         "no nav_msgs/msg/Odometry or sensor_msgs/msg/JointState topic: the bag gives no wheel "
         "odometry");
+  return c;
+}
 
-  // Decoded on every core, kept in file order.
-  struct Decoded {
-    enum Kind { none, ceiling, omni, odometry, joints, info, bad } kind = none;
-    Logged<ImageFrame> image;
-    Logged<OdometryPose> odo;
-    Logged<WheelJoints> wheel;
-    CameraInfo info_value;
-    std::string topic, problem;
-  };
-  std::vector<Decoded> decoded(f.messages.size());
-  auto decode = [&](std::size_t i) {
-    const McapMessage& m = f.messages[i];
-    const McapChannel* ch = f.channel(m.channel_id);
-    if (!ch || !cdr(*ch)) return;
-    Decoded& d = decoded[i];
-    const Stamp avail = stamp_from_nanoseconds(static_cast<std::int64_t>(m.log_time));
-    const std::string type = type_of(f, *ch);
-    try {
-      if (ch == ceiling || ch == omni) {
-        d.image = {avail,
-                   type == "sensor_msgs/Image" ? raw_image(m.data) : compressed_image(m.data)};
-        if (d.image.value.frame_id.empty())
-          d.image.value.frame_id = ch == ceiling ? "ceiling_camera" : "omni_camera";
-        d.kind = ch == ceiling ? Decoded::ceiling : Decoded::omni;
-      } else if (ch == odom) {
-        d.odo = {avail, odometry(m.data)};
-        d.kind = Decoded::odometry;
-      } else if (ch == joints && !odom) {
-        d.wheel = {avail, wheel_joints(m.data, wanted.left_joint, wanted.right_joint)};
-        d.kind = Decoded::joints;
-      } else if (type == "sensor_msgs/CameraInfo") {
-        d.info_value = camera_info(m.data);
-        d.topic = ch->topic;
-        d.kind = Decoded::info;
-      }
-    } catch (const CdrError& e) {
-      d.kind = Decoded::bad;
-      d.problem = ch->topic + " message " + std::to_string(m.sequence) + " (" + type +
-                  "): " + e.what() + " (skipped)";
-    } catch (const InputError& e) {
-      d.kind = Decoded::bad;
-      d.problem =
-          ch->topic + " message " + std::to_string(m.sequence) + ": " + e.what() + " (skipped)";
+void decode_ros2(const Ros2Channels& c, const McapChannel& ch, const McapMessage& m,
+                 DecodedMessage& d) {
+  using Kind = DecodedMessage::Kind;
+  const auto it = c.types.find(ch.id);
+  if (it == c.types.end()) return;
+  const std::string& type = it->second;
+  const Stamp avail = stamp_from_nanoseconds(static_cast<std::int64_t>(m.log_time));
+  try {
+    if (&ch == c.ceiling || &ch == c.omni) {
+      d.image = {avail, type == "sensor_msgs/Image" ? raw_image(m.data) : compressed_image(m.data)};
+      if (d.image.value.frame_id.empty())
+        d.image.value.frame_id = &ch == c.ceiling ? "ceiling_camera" : "omni_camera";
+      d.kind = &ch == c.ceiling ? Kind::ceiling : Kind::omni;
+    } else if (&ch == c.odometry) {
+      d.odometry = {avail, odometry(m.data)};
+      d.kind = Kind::odometry;
+    } else if (&ch == c.joints) {
+      d.joints = {avail, wheel_joints(m.data, c.left_joint, c.right_joint)};
+      d.kind = Kind::joints;
+    } else if (type == "sensor_msgs/CameraInfo") {
+      d.camera_info = std::make_unique<CameraInfo>(camera_info(m.data));
+      d.topic = ch.topic;
+      d.kind = Kind::camera_info;
     }
-  };
-  for_each_index(decoded.size(), decode);
-  log.ros2_bag = true;
-  for (auto& d : decoded) {
-    switch (d.kind) {
-      case Decoded::ceiling:
-        log.ceiling_images.push_back(std::move(d.image));
-        break;
-      case Decoded::omni:
-        log.omni_images.push_back(std::move(d.image));
-        break;
-      case Decoded::odometry:
-        log.odometry.push_back(std::move(d.odo));
-        break;
-      case Decoded::joints:
-        log.wheel_joints.push_back(std::move(d.wheel));
-        break;
-      case Decoded::info:
-        log.camera_info[d.topic] = std::move(d.info_value);
-        break;
-      case Decoded::bad:
-        ++log.skipped_messages;
-        log.problems.push_back(std::move(d.problem));
-        break;
-      case Decoded::none:
-        break;
-    }
+  } catch (const CdrError& e) {
+    d.kind = Kind::bad;
+    d.problem = skipped(ch, m, e.what(), type);
+  } catch (const InputError& e) {
+    d.kind = Kind::bad;
+    d.problem = skipped(ch, m, e.what());
   }
 }
 
+namespace {
+
+// A copy of a bag's readings in capture order.
+template <class T>
+std::vector<Logged<T>> by_capture(std::vector<Logged<T>> v) {
+  std::stable_sort(v.begin(), v.end(),
+                   [](const auto& a, const auto& b) { return a.value.stamp < b.value.stamp; });
+  return v;
+}
+
+}  // namespace
+
 void wheels_from_odometry(MissionLog& log, double semi_axis) {
   if (!log.wheels.empty() || log.odometry.size() < 2) return;
-  auto odo = log.odometry;
-  std::stable_sort(odo.begin(), odo.end(),
-                   [](const auto& a, const auto& b) { return a.value.stamp < b.value.stamp; });
+  const auto odo = by_capture(log.odometry);
   double left = 0, right = 0;
   log.wheels.push_back({odo.front().log_time, {odo.front().value.stamp, 0.0, 0.0}});
   for (std::size_t k = 1; k < odo.size(); ++k) {
@@ -405,15 +370,9 @@ void wheels_from_odometry(MissionLog& log, double semi_axis) {
   }
 }
 
-}  // namespace lampnav::io
-
-namespace lampnav::io {
-
 void wheels_from_joints(MissionLog& log, double wheel_radius) {
   if (!log.wheels.empty() || log.wheel_joints.empty()) return;
-  auto joints = log.wheel_joints;
-  std::stable_sort(joints.begin(), joints.end(),
-                   [](const auto& a, const auto& b) { return a.value.stamp < b.value.stamp; });
+  const auto joints = by_capture(log.wheel_joints);
   const double l0 = joints.front().value.left, r0 = joints.front().value.right;
   Stamp last;
   for (const auto& j : joints) {

@@ -1,12 +1,11 @@
 #include "lampnav/mapping/map_builder.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
-#include <thread>
 
 #include "lampnav/core/error.hpp"
+#include "lampnav/core/parallel.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "median.hpp"
@@ -109,23 +108,15 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
   // then, with the wheels in time order, the lamp SLAM.
   std::vector<std::vector<vision::LampDetection>> detected(frames.size());
   std::vector<char> unreadable(frames.size(), 0);
-  const unsigned workers = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
-  std::atomic<std::size_t> next{0}, done{0};
-  auto work = [&] {
-    vision::LampDetector detector(*cam, out.prior, o.detector);
-    for (std::size_t i = next++; i < frames.size(); i = next++) {
-      try {
-        detected[i] = detector.detect(io::decode_image(frames[i]->value.data, source)).lamps;
-      } catch (const std::exception&) {
-        unreadable[i] = 1;
-      }
-      ++done;
-    }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned k = 1; k < workers; ++k) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
+  for_each_index(
+      frames.size(), [&] { return vision::LampDetector(*cam, out.prior, o.detector); },
+      [&](vision::LampDetector& detector, std::size_t i) {
+        try {
+          detected[i] = detector.detect(io::decode_image(frames[i]->value.data, source)).lamps;
+        } catch (const std::exception&) {
+          unreadable[i] = 1;
+        }
+      });
   if (progress) progress(0.9);
   out.detect_seconds = since(t0);
   const auto t1 = std::chrono::steady_clock::now();

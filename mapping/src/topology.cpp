@@ -295,42 +295,39 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     if (!ra.bounds().intersects(rb.bounds())) return 0.0;
     return graph::intersection_area(ra, rb);
   };
-  for (std::size_t b = 0; b < nodes.size(); ++b) {
-    for (std::size_t a = 0; a < b && !dropped[b]; ++a) {
-      if (dropped[a]) continue;
-      for (int step = 0; step < 40 && !dropped[b] && overlap(a, b) > allowed; ++step) {
+  // One step of giving way to `other`: a corridor shortened by 10 cm at its end nearer the other,
+  // a place shrunk by a tenth; false when what is left is too small to keep.
+  auto give_way = [&](graph::Node& n, const graph::Node& other) {
+    if (n.axis) {
+      graph::Axis& ax = *n.axis;
+      const Vector2d c = other.region.centroid();
+      const Vector2d d = ax.direction() * 0.1;
+      if ((ax.first - c).norm() < (ax.second - c).norm())
+        ax.first += d;
+      else
+        ax.second -= d;
+      if (ax.length() < 0.5) return false;
+      n.region = rectangle(ax.first, ax.second, w);
+      n.point = 0.5 * (ax.first + ax.second);
+      return true;
+    }
+    std::vector<Vector2d> smaller;
+    for (const auto& p : n.region.vertices()) smaller.push_back(n.point + 0.9 * (p - n.point));
+    n.region = graph::Polygon(smaller);
+    return (smaller[0] - smaller[1]).norm() >= 0.5;
+  };
+  for (std::size_t b = 0; b < nodes.size(); ++b)
+    for (std::size_t a = 0; a < b; ++a) {
+      if (dropped[a] || dropped[b]) continue;
+      for (int step = 0; step < 40 && overlap(a, b) > allowed; ++step) {
         // The one to give way: a corridor before a place, else the later one.
         const std::size_t g = nodes[b].axis || !nodes[a].axis ? b : a;
-        graph::Node& n = nodes[g];
-        const graph::Node& other = nodes[g == b ? a : b];
-        if (n.axis) {
-          graph::Axis& ax = *n.axis;
-          const Vector2d c = other.region.centroid();
-          const Vector2d d = ax.direction() * 0.1;
-          if ((ax.first - c).norm() < (ax.second - c).norm())
-            ax.first += d;
-          else
-            ax.second -= d;
-          if (ax.length() < 0.5) {
-            dropped[g] = true;
-            break;
-          }
-          n.region = rectangle(ax.first, ax.second, w);
-          n.point = 0.5 * (ax.first + ax.second);
-        } else {
-          const auto& v = n.region.vertices();
-          std::vector<Vector2d> smaller;
-          for (const auto& p : v) smaller.push_back(n.point + 0.9 * (p - n.point));
-          n.region = graph::Polygon(smaller);
-          if ((smaller[0] - smaller[1]).norm() < 0.5) {
-            dropped[g] = true;
-            break;
-          }
+        if (!give_way(nodes[g], nodes[g == b ? a : b])) {
+          dropped[g] = true;
+          break;
         }
-        if (dropped[a]) break;
       }
     }
-  }
   std::size_t left_out = 0;
   for (std::size_t i = 0; i < nodes.size(); ++i) left_out += dropped[i];
   if (left_out)

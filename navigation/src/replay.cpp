@@ -11,7 +11,7 @@
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/ekf.hpp"
-#include "text_file.hpp"
+#include "lampnav/internal/json_util.hpp"
 
 namespace lampnav::navigation {
 
@@ -429,14 +429,14 @@ void write_replay(const ReplayResult& r, const io::MissionLog& log,
   std::vector<std::pair<Stamp, Pose2>> est;  // the poses published as tracking only (cli.md)
   for (const auto& e : r.estimates)
     if (e.mode == fusion::LocalizerMode::tracking) est.emplace_back(e.stamp, e.pose);
-  write_text_file(dir + "/estimate.tum", tum(est));
+  json::write_file(dir + "/estimate.tum", tum(est));
   if (!log.truth.empty()) {
     const io::TruthTrack truth(log.truth);
     std::vector<std::pair<Stamp, Pose2>> t;
     for (const auto& s : truth.samples()) t.emplace_back(s.value.stamp, s.value.pose);
-    write_text_file(dir + "/truth.tum", tum(t));
+    json::write_file(dir + "/truth.tum", tum(t));
   }
-  write_text_file(dir + "/metrics.json", metrics_json(r.metrics));
+  json::write_file(dir + "/metrics.json", metrics_json(r.metrics));
 }
 
 }  // namespace lampnav::navigation

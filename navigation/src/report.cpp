@@ -9,7 +9,7 @@
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/ekf.hpp"
-#include "text_file.hpp"
+#include "lampnav/internal/json_util.hpp"
 
 namespace lampnav::navigation {
 
@@ -445,8 +445,8 @@ void write_report(const ReplayResult& r, const io::MissionLog& log,
                   const graph::TopologicalMap& map, const std::string& title,
                   const std::string& dir) {
   const std::vector<Figure> figures = report_figures(r, log, map);
-  write_text_file(dir + "/report.html", report_html(r, log, figures, title));
-  for (const auto& f : figures) write_text_file(dir + "/" + f.file, f.svg);
+  json::write_file(dir + "/report.html", report_html(r, log, figures, title));
+  for (const auto& f : figures) json::write_file(dir + "/" + f.file, f.svg);
 }
 
 }  // namespace lampnav::navigation

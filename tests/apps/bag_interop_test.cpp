@@ -43,8 +43,7 @@ TEST(BagInterop, ABagWrittenByRos2ToolingReplaysAsTheMission) {
        {"@mcap/core", "@foxglove/rosmsg2-serialization", "@foxglove/rosmsg-msgs-common"})
     ASSERT_TRUE(fs::exists(interop + "/node_modules/" + package))
         << package << " is not installed: run `make test`, which installs it";
-  const std::string dir =
-      (fs::temp_directory_path() / ("lampnav_bag_interop_" + std::to_string(::getpid()))).string();
+  const std::string dir = test::temp_path("bag_interop");
   fs::create_directories(dir);
   const std::string log = dir + "/corridor.mcap", bag = dir + "/corridor_bag.mcap";
   ASSERT_EQ(test::run_lampnav("sim --scenario corridor -o '" + log + "'").status, 0);

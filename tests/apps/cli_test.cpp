@@ -222,9 +222,8 @@ namespace {
 
 // robot import: the cameras from calibration files, the wheels and mounts kept.
 TEST(Cli, RobotImportTakesCalibrationsKeepingWheelsAndMounts) {
-  const auto dir = std::filesystem::temp_directory_path();
-  const std::string calib = (dir / ("lampnav_cli_calib_" + std::to_string(::getpid()) + ".yaml"));
-  const std::string out = (dir / ("lampnav_cli_robot_" + std::to_string(::getpid()) + ".json"));
+  const std::string calib = test::temp_path("cli_calib.yaml");
+  const std::string out = test::temp_path("cli_robot.json");
   std::ofstream(calib) << "image_width: 1280\nimage_height: 1024\ncamera_name: omni\n"
                           "camera_matrix: {rows: 3, cols: 3, data: [402.1, 0, 641.3, 0, 401.7, "
                           "509.2, 0, 0, 1]}\ndistortion_model: equidistant\n"

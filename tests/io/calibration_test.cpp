@@ -23,14 +23,8 @@ using Eigen::Vector2d;
 using Eigen::Vector3d;
 using ::testing::HasSubstr;
 
-std::string temp_file(const std::string& name) {
-  return (std::filesystem::temp_directory_path() /
-          ("lampnav_calib_" + std::to_string(::getpid()) + "_" + name))
-      .string();
-}
-
 std::string write(const std::string& name, const std::string& text) {
-  const std::string path = temp_file(name);
+  const std::string path = test::temp_path(name);
   std::ofstream(path) << text;
   return path;
 }
@@ -168,7 +162,8 @@ cam1:
 TEST(Calibration, OpenCvFilesWrittenByOpenCv) {
   for (const char* ext : {".xml", ".yaml"}) {
     for (const bool fisheye : {false, true}) {
-      const std::string path = temp_file(std::string("opencv") + (fisheye ? "_fish" : "") + ext);
+      const std::string path =
+          test::temp_path(std::string("opencv") + (fisheye ? "_fish" : "") + ext);
       const cv::Matx33d K(500.5, 0, 319.1, 0, 501.2, 238.9, 0, 0, 1);
       const std::vector<double> D = fisheye
                                         ? std::vector<double>{0.05, -0.01, 0.002, -0.0002}

@@ -21,12 +21,6 @@ namespace {
 using test::CdrWriter;
 using ::testing::HasSubstr;
 
-std::string temp_file(const std::string& name) {
-  return (std::filesystem::temp_directory_path() /
-          ("lampnav_bag_" + std::to_string(::getpid()) + "_" + name))
-      .string();
-}
-
 // A bag: topics (name, type) and messages (topic index, log time ns, CDR bytes).
 struct Bag {
   std::vector<std::pair<std::string, std::string>> topics;
@@ -37,7 +31,7 @@ struct Bag {
   };
   std::vector<Message> messages;
   std::string write(const std::string& name) const {
-    const std::string path = temp_file(name);
+    const std::string path = test::temp_path(name);
     McapWriter w(path, {"ros2"});
     std::vector<std::uint16_t> channels;
     for (const auto& [topic, type] : topics) {

@@ -67,8 +67,7 @@ TEST(BagReplay, ABagOfTheOfficeMissionGivesTheSameEstimates) {
   const RobotDescription robot =
       read_robot_description(test::source_path("maps/robots/pioneer.json"));
   const sim::Scenario s = sim::make_named_scenario("office-mission", map, geojson, robot, 1);
-  const std::string dir =
-      (fs::temp_directory_path() / ("lampnav_bag_replay_" + std::to_string(::getpid()))).string();
+  const std::string dir = test::temp_path("bag_replay");
   fs::create_directories(dir);
   sim::record_mission(s, dir + "/mission.mcap");
   const io::MissionLog log = io::read_mission_log(dir + "/mission.mcap");

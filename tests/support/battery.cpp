@@ -198,9 +198,9 @@ struct Battery::Impl {
           ++r.unsure_frames;
           r.unsure_hypotheses += live;
           if (live >= 50 && live <= 200) {
-            r.crowded_s += took;
-            ++r.crowded_frames;
-            r.crowded_hypotheses += live;
+            r.many_s += took;
+            ++r.many_frames;
+            r.many_hypotheses += live;
           }
         }
         if (o.trace) o.trace(t, truth, loc);
@@ -288,8 +288,8 @@ EpisodeResult Battery::unknown_start_at(const Pose2& start, std::uint64_t seed) 
 BatteryFigures figures(const std::vector<EpisodeResult>& rs) {
   BatteryFigures f;
   std::vector<double> lat_s, lat_m, past;
-  double unsure_s = 0, crowded_s = 0, all_s = 0;
-  std::size_t unsure_frames = 0, unsure_hyp = 0, crowded_hyp = 0, all_frames = 0;
+  double unsure_s = 0, many_s = 0, all_s = 0;
+  std::size_t unsure_frames = 0, unsure_hyp = 0, many_hyp = 0, all_frames = 0;
   for (const auto& r : rs) {
     ++f.episodes;
     f.detected += r.detected;
@@ -300,9 +300,9 @@ BatteryFigures figures(const std::vector<EpisodeResult>& rs) {
     unsure_s += r.unsure_s;
     unsure_frames += r.unsure_frames;
     unsure_hyp += r.unsure_hypotheses;
-    crowded_s += r.crowded_s;
-    f.crowded_frames += r.crowded_frames;
-    crowded_hyp += r.crowded_hypotheses;
+    many_s += r.many_s;
+    f.many_frames += r.many_frames;
+    many_hyp += r.many_hypotheses;
     all_s += r.localizer_s;
     all_frames += r.frames;
     if (r.fixed) {
@@ -331,9 +331,9 @@ BatteryFigures figures(const std::vector<EpisodeResult>& rs) {
     f.unsure_us_per_frame = 1e6 * unsure_s / unsure_frames;
     f.unsure_mean_hypotheses = double(unsure_hyp) / unsure_frames;
   }
-  if (f.crowded_frames) {
-    f.crowded_us_per_frame = 1e6 * crowded_s / f.crowded_frames;
-    f.crowded_mean_hypotheses = double(crowded_hyp) / f.crowded_frames;
+  if (f.many_frames) {
+    f.many_us_per_frame = 1e6 * many_s / f.many_frames;
+    f.many_mean_hypotheses = double(many_hyp) / f.many_frames;
   }
   if (all_frames) f.amortized_us_per_frame = 1e6 * all_s / all_frames;
   return f;

@@ -42,8 +42,8 @@ struct EpisodeResult {
   std::size_t unsure_frames = 0, unsure_hypotheses = 0;
   // Of those, the frames that found 50 to 200 live hypotheses (the target's "100"), and every
   // frame given to the localizer (tracking too): time and count.
-  double crowded_s = 0;
-  std::size_t crowded_frames = 0, crowded_hypotheses = 0;
+  double many_s = 0;
+  std::size_t many_frames = 0, many_hypotheses = 0;
   std::string last_why;  // the localizer's last word when it never fixed
   // The map oracle on the drive from the kidnap (or start) on: the travel after which no other
   // place fits the lamps seen (sim::MapOracle); empty when a twin fits the whole drive.
@@ -100,8 +100,8 @@ struct BatteryFigures {
   std::size_t max_hypotheses = 0;
   double unsure_us_per_frame = 0, unsure_mean_hypotheses = 0;
   // Frames that found 50 to 200 live hypotheses, and every frame (amortized).
-  double crowded_us_per_frame = 0, crowded_mean_hypotheses = 0;
-  std::size_t crowded_frames = 0;
+  double many_us_per_frame = 0, many_mean_hypotheses = 0;
+  std::size_t many_frames = 0;
   double amortized_us_per_frame = 0;
   // Against the map oracle: episodes it decided within the drive, episodes fixed right within
   // its distance plus 10 m (the target; an oracle undecided when the drive ended decides after

@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -24,6 +26,13 @@ inline std::string source_path(const std::string& relative) {
 }
 inline std::string fixture(const std::string& relative) {
   return source_path("tests/fixtures/" + relative);
+}
+// A path in the temporary directory, named for this process so that test binaries running side
+// by side do not meet.
+inline std::string temp_path(const std::string& name) {
+  return (std::filesystem::temp_directory_path() /
+          ("lampnav_" + std::to_string(::getpid()) + "_" + name))
+      .string();
 }
 
 // The whole content of a file ("" when it cannot be read).

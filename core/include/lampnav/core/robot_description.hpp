@@ -17,6 +17,8 @@ struct Mount {
 };
 
 enum class CameraModelKind { pinhole, pajdla_bakstein, kannala_brandt };
+// "pinhole", "pajdla_bakstein", "kannala_brandt": the model's name in robot.json.
+const char* to_string(CameraModelKind k);
 // The fisheye models: radially symmetric, a radius (px) for each angle off the optical axis.
 inline bool is_fisheye(CameraModelKind k) {
   return k == CameraModelKind::pajdla_bakstein || k == CameraModelKind::kannala_brandt;

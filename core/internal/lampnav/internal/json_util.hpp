@@ -19,6 +19,8 @@ using Json = nlohmann::json;
 
 // Reads a whole file; a missing or unreadable file is an InputError naming it.
 std::string read_file(const std::string& path);
+// Writes a whole file; one that cannot be written is an InputError naming it.
+void write_file(const std::string& path, const std::string& text);
 
 // Parses JSON text; a syntax error is an InputError giving line and column.
 Json parse(const std::string& text, const std::string& file);
