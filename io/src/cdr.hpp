@@ -5,19 +5,19 @@
 // Each primitive is aligned to its own size (8 at most), counted from the byte after the header;
 // a string is a uint32 length including its terminating NUL, then the bytes; a sequence a uint32
 // count, then the elements; a fixed-size array the elements alone.
-// Every failure throws CdrError naming the field being read and the byte offset.
+// Every failure throws CdrError naming the field being read and the byte offset. CdrWriter
+// writes the same encoding.
 
+#include <cctype>
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
-namespace lampnav::io {
+#include "lampnav/io/ros2_messages.hpp"  // CdrError
 
-struct CdrError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
+namespace lampnav::io {
 
 class CdrReader {
  public:
@@ -125,5 +125,71 @@ class CdrReader {
   std::size_t pos_ = 0;
   bool little_ = true;
 };
+
+// Writes CDR as CdrReader reads it, in either byte order (little endian unless told).
+class CdrWriter {
+ public:
+  explicit CdrWriter(bool little_endian = true) : little_(little_endian) {
+    out_ = {'\0', little_endian ? '\1' : '\0', '\0', '\0'};
+  }
+  CdrWriter& u8(std::uint8_t v) { return put(v); }
+  CdrWriter& u32(std::uint32_t v) { return put(v); }
+  CdrWriter& i32(std::int32_t v) { return put(static_cast<std::uint32_t>(v)); }
+  CdrWriter& f64(double v) {
+    std::uint64_t b;
+    std::memcpy(&b, &v, sizeof b);
+    return put(b);
+  }
+  CdrWriter& string(const std::string& s) {
+    u32(static_cast<std::uint32_t>(s.size() + 1));
+    out_ += s;
+    out_ += '\0';
+    return *this;
+  }
+  CdrWriter& bytes(const std::string& b) {
+    u32(static_cast<std::uint32_t>(b.size()));
+    out_ += b;
+    return *this;
+  }
+  CdrWriter& f64s(const std::vector<double>& v) {
+    u32(static_cast<std::uint32_t>(v.size()));
+    for (double x : v) f64(x);
+    return *this;
+  }
+  CdrWriter& strings(const std::vector<std::string>& v) {
+    u32(static_cast<std::uint32_t>(v.size()));
+    for (const auto& x : v) string(x);
+    return *this;
+  }
+  // std_msgs/msg/Header.
+  CdrWriter& header(std::int64_t stamp_ns, const std::string& frame_id) {
+    const std::int64_t sec =
+        stamp_ns >= 0 ? stamp_ns / 1'000'000'000 : -((-stamp_ns + 999'999'999) / 1'000'000'000);
+    i32(static_cast<std::int32_t>(sec));
+    u32(static_cast<std::uint32_t>(stamp_ns - sec * 1'000'000'000));
+    return string(frame_id);
+  }
+  const std::string& data() const { return out_; }
+  std::string take() { return std::move(out_); }
+
+ private:
+  template <class T>
+  CdrWriter& put(T v) {
+    while ((out_.size() - 4) % sizeof(T)) out_ += '\0';
+    for (std::size_t k = 0; k < sizeof(T); ++k) {
+      const std::size_t shift = 8 * (little_ ? k : sizeof(T) - 1 - k);
+      out_ += static_cast<char>((static_cast<std::uint64_t>(v) >> shift) & 0xFF);
+    }
+    return *this;
+  }
+  bool little_;
+  std::string out_;
+};
+
+// ASCII lower case, for matching topic and joint names.
+inline std::string lower(std::string t) {
+  for (auto& c : t) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return t;
+}
 
 }  // namespace lampnav::io

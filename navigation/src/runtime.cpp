@@ -20,17 +20,19 @@ Runtime::Runtime(const graph::TopologicalMap& map, const RobotDescription& robot
     : map_(&map),
       o_(options),
       localizer_(map, robot, options.localizer),
-      executor_(map, robot.semi_axis, options.executor) {
+      executor_(map, robot.semi_axis, options.executor),
+      semi_axis_(robot.semi_axis) {
   o_.validate();
 }
 
 RunOutcome Runtime::run(Robot& robot, const std::optional<Pose2>& start,
-                        const std::vector<graph::RouteCommand>& commands,
-                        RuntimeObserver* observer) {
+                        const std::vector<graph::RouteCommand>& commands, RuntimeObserver* observer,
+                        bool keep_running) {
   RunOutcome out;
   RuntimeObserver none;
   RuntimeObserver& obs = observer ? *observer : none;
-  const bool driving = !commands.empty();
+  std::vector<graph::RouteCommand> mission = commands;
+  bool driving = !mission.empty();  // a mission to start or in progress
   auto stop = [&] { robot.set_wheel_speeds(0, 0); };
   while (auto input = robot.next()) {
     if (const auto* w = std::get_if<WheelInput>(&*input)) {
@@ -50,18 +52,37 @@ RunOutcome Runtime::run(Robot& robot, const std::optional<Pose2>& start,
       obs.on_estimate(e);
       if (driving) {
         if (executor_.status() == ExecutorStatus::idle && e.known())
-          executor_.start(e.stamp, e.pose, commands);
+          executor_.start(e.stamp, e.pose, mission);
         const WheelSpeeds s = executor_.step(e);
         robot.set_wheel_speeds(s.left, s.right);
-        if (executor_.status() == ExecutorStatus::arrived) break;
-        if (executor_.status() == ExecutorStatus::failed) {
-          out.reason = executor_.reason();
-          break;
+        const ExecutorStatus st = executor_.status();
+        if (st == ExecutorStatus::arrived || st == ExecutorStatus::failed) {
+          if (st == ExecutorStatus::failed) out.reason = executor_.reason();
+          if (!keep_running) break;
+          driving = false;
+          stop();
         }
       }
       if (to_seconds(*out.last - *out.first) > o_.max_duration_s) {
         out.time_limit = true;
         break;
+      }
+      continue;
+    }
+    if (const auto* c = std::get_if<CommandInput>(&*input)) {
+      try {
+        std::vector<graph::RouteCommand> parsed = graph::parse_route_commands(c->text);
+        graph::check_commands(*map_, parsed);
+        if (parsed.empty()) throw InputError({"", "command", ""}, "no command in the text");
+        mission = std::move(parsed);
+        executor_ = Executor(*map_, semi_axis_, o_.executor);  // the new mission replaces the old
+        driving = true;
+        out.reason.clear();
+        ++out.commands;
+        obs.on_command(*c, "");
+      } catch (const InputError& e) {
+        ++out.refused_commands;
+        obs.on_command(*c, e.what());
       }
       continue;
     }
@@ -84,7 +105,7 @@ RunOutcome Runtime::run(Robot& robot, const std::optional<Pose2>& start,
   }
   stop();
   out.status = executor_.status();
-  if (driving && out.status != ExecutorStatus::arrived && out.reason.empty())
+  if (!mission.empty() && out.status != ExecutorStatus::arrived && out.reason.empty())
     out.reason = out.time_limit ? "the time limit came first" : "the robot stopped giving input";
   return out;
 }

@@ -12,7 +12,7 @@ SimulatedRobot::SimulatedRobot(const Scenario& scenario, const std::string& log_
   scenario_.validate();
   world_ = std::make_unique<World>(scenario_, log_path);
   world_->hold();  // the state at t = 0, and its reading as the first input
-  queue_.push_back(navigation::WheelInput{stamp_from_nanoseconds(0), 0.0, 0.0});
+  queue_.push_back(WheelInput{stamp_from_nanoseconds(0), 0.0, 0.0});
 }
 
 SimulatedRobot::~SimulatedRobot() { finish(); }
@@ -24,7 +24,7 @@ void SimulatedRobot::set_wheel_speeds(double left, double right) {
   right_ = std::isfinite(right) ? std::clamp(right, -top, top) : 0.0;
 }
 
-std::optional<navigation::RobotInput> SimulatedRobot::next() {
+std::optional<RobotInput> SimulatedRobot::next() {
   if (queue_.empty()) {
     if (finished_ || world_->now_ns() >= static_cast<std::int64_t>(scenario_.max_duration_s * 1e9))
       return std::nullopt;
@@ -38,14 +38,14 @@ std::optional<navigation::RobotInput> SimulatedRobot::next() {
     world_->drive(0.5 * (left_ + right_), (right_ - left_) / (2 * a));
     const WheelTravel& r = world_->readings();
     queue_.push_back(
-        navigation::WheelInput{stamp_from_nanoseconds(world_->now_ns()), r.left, r.right});
+        WheelInput{stamp_from_nanoseconds(world_->now_ns()), r.left, r.right});
     for (ArrivedFrame& f : world_->deliver(world_->now_ns()))
-      queue_.push_back(navigation::FrameInput{
-          f.ceiling ? navigation::CameraRole::ceiling : navigation::CameraRole::omni,
+      queue_.push_back(FrameInput{
+          f.ceiling ? CameraRole::ceiling : CameraRole::omni,
           stamp_from_nanoseconds(f.capture_ns), stamp_from_nanoseconds(f.arrival_ns),
           std::move(f.image)});
   }
-  navigation::RobotInput in = std::move(queue_.front());
+  RobotInput in = std::move(queue_.front());
   queue_.pop_front();
   return in;
 }

@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "lampnav/io/mission_log.hpp"
-#include "lampnav/navigation/robot.hpp"
+#include "lampnav/core/robot.hpp"
 #include "lampnav/navigation/runtime.hpp"
 
 namespace lampnav::navigation {

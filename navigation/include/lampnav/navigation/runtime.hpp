@@ -13,7 +13,7 @@
 #include "lampnav/graph/map.hpp"
 #include "lampnav/graph/route_commands.hpp"
 #include "lampnav/navigation/executor.hpp"
-#include "lampnav/navigation/robot.hpp"
+#include "lampnav/core/robot.hpp"
 
 namespace lampnav::navigation {
 
@@ -36,12 +36,15 @@ class RuntimeObserver {
   virtual void on_omni(const FrameInput& /*frame*/, const vision::OmniDetection& /*detection*/) {}
   // A frame that is not an image of its camera (size, depth), with why.
   virtual void on_refused(const FrameInput& /*frame*/, const std::string& /*why*/) {}
+  // Route commands given while running: taken (why empty) or refused, with why.
+  virtual void on_command(const CommandInput& /*command*/, const std::string& /*why*/) {}
 };
 
 struct RunOutcome {
   ExecutorStatus status = ExecutorStatus::idle;  // idle: no commands were given
   std::string reason;                            // why the mission failed
   std::size_t wheel_readings = 0, ceiling_frames = 0, omni_frames = 0, refused_frames = 0;
+  std::size_t commands = 0, refused_commands = 0;  // given while running
   std::optional<Stamp> first, last;  // robot time span
   bool time_limit = false;           // stopped by max_duration_s
   double duration_s() const { return first && last ? to_seconds(*last - *first) : 0.0; }
@@ -55,10 +58,12 @@ class Runtime {
 
   // Runs until the robot has no more input, the commands are carried out or have failed, or the
   // time limit. With `start` the localizer starts there; without, it finds the robot from the omni
-  // camera first. With commands, the executor starts once the robot's pose is known.
+  // camera first. With commands, the executor starts once the robot's pose is known; commands
+  // that arrive as input replace them. With `keep_running` the loop goes on after the mission
+  // arrives or fails (a live robot waits for the next command); otherwise it ends there.
   RunOutcome run(Robot& robot, const std::optional<Pose2>& start,
                  const std::vector<graph::RouteCommand>& commands,
-                 RuntimeObserver* observer = nullptr);
+                 RuntimeObserver* observer = nullptr, bool keep_running = false);
 
   const fusion::Localizer& localizer() const { return localizer_; }
   const Executor& executor() const { return executor_; }
@@ -68,6 +73,7 @@ class Runtime {
   RuntimeOptions o_;
   fusion::Localizer localizer_;
   Executor executor_;
+  double semi_axis_;
 };
 
 }  // namespace lampnav::navigation

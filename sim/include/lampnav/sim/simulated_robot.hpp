@@ -1,5 +1,5 @@
 #pragma once
-// The simulated robot behind navigation::Robot: the stack sets its wheel speeds, it answers with
+// The simulated robot behind Robot: the stack sets its wheel speeds, it answers with
 // encoder readings at the odometry rate and camera frames when they arrive (after their delay),
 // and everything, truth included, goes to a mission log. Kidnaps happen as the scenario says.
 
@@ -7,14 +7,14 @@
 #include <memory>
 #include <string>
 
-#include "lampnav/navigation/robot.hpp"
+#include "lampnav/core/robot.hpp"
 #include "lampnav/sim/scenario.hpp"
 
 namespace lampnav::sim {
 
 class World;
 
-class SimulatedRobot : public navigation::Robot {
+class SimulatedRobot : public Robot {
  public:
   // Writes the mission log to `log_path`. Throws InputError for a bad scenario.
   SimulatedRobot(const Scenario& scenario, const std::string& log_path);
@@ -22,7 +22,7 @@ class SimulatedRobot : public navigation::Robot {
 
   void set_wheel_speeds(double left, double right) override;
   // Ends (nullopt) at the scenario's max_duration_s or after finish().
-  std::optional<navigation::RobotInput> next() override;
+  std::optional<RobotInput> next() override;
 
   // The true pose now (for scoring and demos, never for the stack).
   Pose2 truth() const;
@@ -33,7 +33,7 @@ class SimulatedRobot : public navigation::Robot {
  private:
   Scenario scenario_;
   std::unique_ptr<World> world_;
-  std::deque<navigation::RobotInput> queue_;
+  std::deque<RobotInput> queue_;
   double left_ = 0, right_ = 0;
   std::size_t next_kidnap_ = 0;
   bool finished_ = false;

@@ -1,15 +1,16 @@
 #pragma once
-// The small interface the stack drives a robot through: wheel speeds out; wheel readings and
-// camera frames in, in the order they arrive. A real robot, the simulated one (sim/) and a
-// recorded mission (replay) all stand behind it.
+// The small interface the stack drives a robot through: wheel speeds out; wheel readings, camera
+// frames and route commands in, in the order they arrive. A real robot (the DDS node, ros/), the
+// simulated one (sim/) and a recorded mission (replay) all stand behind it.
 
 #include <optional>
+#include <string>
 #include <variant>
 
 #include "lampnav/core/image.hpp"
 #include "lampnav/core/time.hpp"
 
-namespace lampnav::navigation {
+namespace lampnav {
 
 enum class CameraRole { ceiling, omni };
 
@@ -25,7 +26,14 @@ struct FrameInput {
   Image8 image;
 };
 
-using RobotInput = std::variant<WheelInput, FrameInput>;
+// Route commands given while the robot runs (shared/spec/cli.md's command text). They replace
+// the mission in progress.
+struct CommandInput {
+  Stamp arrival;
+  std::string text;
+};
+
+using RobotInput = std::variant<WheelInput, FrameInput, CommandInput>;
 
 class Robot {
  public:
@@ -37,4 +45,4 @@ class Robot {
   virtual std::optional<RobotInput> next() = 0;
 };
 
-}  // namespace lampnav::navigation
+}  // namespace lampnav
