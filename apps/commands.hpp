@@ -31,6 +31,7 @@ void add_sim_command(CLI::App& app, Job& run);
 void add_locate_command(CLI::App& app, Job& run);
 void add_run_commands(CLI::App& app, Job& run);  // run, replay
 void add_robot_command(CLI::App& app, Job& run);  // robot import
+void add_node_command(CLI::App& app, Job& run);   // node (ROS 2 over DDS)
 
 // A bundled file (maps/..., maps/robots/...): under $LAMPNAV_DATA_DIR, or the source tree.
 std::string data_path(const std::string& relative);

@@ -138,6 +138,7 @@ int main(int argc, char** argv) {
   apps::add_locate_command(app, run);
   apps::add_run_commands(app, run);
   apps::add_robot_command(app, run);
+  apps::add_node_command(app, run);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,218 @@
+// lampnav node: the live node on a ROS 2 system (cli.md, docs/ros2.md). The runtime loop of
+// replay and run, fed by DDS instead of a log or the simulator.
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <atomic>
+#include <csignal>
+#include <iostream>
+#include <memory>
+#include <thread>
+
+#include "commands.hpp"
+#include "lampnav/core/error.hpp"
+#include "lampnav/graph/geojson.hpp"
+#include "lampnav/internal/json_util.hpp"
+#include "lampnav/navigation/runtime.hpp"
+#include "lampnav/ros/ros_robot.hpp"
+
+namespace lampnav::apps {
+
+namespace {
+
+std::atomic<bool> g_stop{false};
+extern "C" void on_signal(int) { g_stop = true; }
+
+struct NodeArgs {
+  std::string robot, map, initial_pose, stats;
+  int domain = -1;
+  bool no_ceiling = false, no_omni = false, quiet = false;
+  ros::RosRobotOptions robot_options;
+};
+
+// Publishes what the loop sees and times each frame from its arrival to the pose it gives.
+struct Publisher : navigation::RuntimeObserver {
+  ros::RosRobot* robot;
+  const navigation::Runtime* runtime;
+  bool quiet = false;
+  std::vector<double> latency_us[2];  // ceiling, omni
+  std::string last_mission;
+
+  void on_estimate(const fusion::LocalizerEstimate& e) override {
+    robot->publish(e);
+    mission_news(e.stamp);
+  }
+  void after_frame(CameraRole camera) {
+    const fusion::Localizer& l = runtime->localizer();
+    const fusion::LocalizerEstimate e = l.estimate();
+    if (!l.initialized() && e.hypotheses.empty()) return;
+    robot->publish(e);
+    latency_us[camera == CameraRole::omni].push_back(
+        std::chrono::duration<double, std::micro>(ros::Clock::now() - robot->last_arrival())
+            .count());
+  }
+  void on_ceiling(const FrameInput&, const fusion::CeilingObservation&) override {
+    after_frame(CameraRole::ceiling);
+  }
+  void on_omni(const FrameInput&, const vision::OmniDetection&) override {
+    after_frame(CameraRole::omni);
+  }
+  void on_refused(const FrameInput& f, const std::string& why) override {
+    diagnostic("warning", std::string(f.camera == CameraRole::ceiling ? "ceiling" : "omni") +
+                              " frame refused: " + why);
+  }
+  void on_command(const CommandInput& c, const std::string& why) override {
+    const std::string text = why.empty() ? "command taken: " + c.text : "command refused: " + why;
+    robot->publish_event(text);
+    if (!quiet) diagnostic("note", text);
+    last_mission.clear();
+  }
+  // The mission's end, once.
+  void mission_news(Stamp) {
+    const navigation::Executor& x = runtime->executor();
+    std::string news;
+    if (x.status() == navigation::ExecutorStatus::arrived) news = "arrived";
+    if (x.status() == navigation::ExecutorStatus::failed) news = "failed: " + x.reason();
+    if (news.empty() || news == last_mission) return;
+    last_mission = news;
+    robot->publish_event("mission " + news);
+    if (!quiet) diagnostic("note", "mission " + news);
+  }
+};
+
+double percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * (v.size() - 1) + 0.5))];
+}
+
+nlohmann::json counts_json(const ros::InputCounts& c) {
+  return {
+      {"received", c.received}, {"used", c.used}, {"refused", c.refused}, {"dropped", c.dropped}};
+}
+
+int run_node(NodeArgs& a) {
+  const RobotDescription robot = read_robot_description(a.robot);
+  const graph::LoadedMap loaded = graph::parse_map(json::read_file(a.map), a.map);
+  std::optional<Pose2> start;
+  if (!a.initial_pose.empty()) start = parse_pose_option(a.initial_pose, "--initial-pose");
+  ros::RosRobotOptions& ro = a.robot_options;
+  ro.semi_axis = robot.semi_axis;
+  if (a.no_ceiling || !robot.find_camera("ceiling_camera")) ro.topics.ceiling_image.clear();
+  if (a.no_omni || !robot.find_camera("omni_camera")) ro.topics.omni_image.clear();
+  if (!start && ro.topics.omni_image.empty())
+    throw InputError({"", "option", "--initial-pose"},
+                     "no starting pose and no omni camera to find the robot with");
+  ro.validate();
+  const int domain = a.domain >= 0 ? a.domain : ros::domain_from_environment();
+
+  navigation::RuntimeOptions opts;
+  opts.max_duration_s = 1e9;  // a live node runs until stopped
+  navigation::Runtime runtime(loaded.map, robot, opts);
+  ros::Participant participant(domain);
+  ros::RosRobot ros_robot(participant, ro);
+  ros_robot.on_problem = [](const std::string& p) { diagnostic("error", p); };
+
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  std::atomic<bool> done{false};
+  std::thread watcher([&] {
+    while (!done) {
+      if (g_stop) ros_robot.stop();
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  });
+  if (!a.quiet)
+    diagnostic("note",
+               "joined ROS 2 domain " + std::to_string(domain) + "; inputs " +
+                   (ro.topics.ceiling_image.empty() ? "" : ro.topics.ceiling_image + ", ") +
+                   (ro.topics.omni_image.empty() ? "" : ro.topics.omni_image + ", ") +
+                   (ro.topics.joint_states.empty() ? ro.topics.odometry : ro.topics.joint_states) +
+                   ", " + ro.topics.command);
+  Publisher pub;
+  pub.robot = &ros_robot;
+  pub.runtime = &runtime;
+  pub.quiet = a.quiet;
+  navigation::RunOutcome out;
+  try {
+    out = runtime.run(ros_robot, start, {}, &pub, true);
+  } catch (...) {
+    done = true;
+    watcher.join();
+    throw;
+  }
+  done = true;
+  watcher.join();
+
+  const ros::NodeCounts c = ros_robot.counts();
+  auto latency = [](const std::vector<double>& v) {
+    return nlohmann::json{{"n", v.size()},
+                          {"p50", percentile(v, 0.5) / 1000},
+                          {"p99", percentile(v, 0.99) / 1000},
+                          {"max", percentile(v, 1.0) / 1000}};
+  };
+  const nlohmann::json ceiling_ms = latency(pub.latency_us[0]),
+                       omni_ms = latency(pub.latency_us[1]);
+  std::cout << "lampnav node: " << out.wheel_readings << " wheel readings, " << out.ceiling_frames
+            << " ceiling and " << out.omni_frames << " omni frames, " << c.poses_published
+            << " poses published; image in to pose out: ceiling p50 " << ceiling_ms["p50"]
+            << " ms, p99 " << ceiling_ms["p99"] << " ms; omni p50 " << omni_ms["p50"] << " ms, p99 "
+            << omni_ms["p99"] << " ms\n";
+  if (!a.stats.empty()) {
+    nlohmann::json j = {{"domain", domain},
+                        {"ceiling", counts_json(c.ceiling)},
+                        {"omni", counts_json(c.omni)},
+                        {"odometry", counts_json(c.odometry)},
+                        {"commands", counts_json(c.commands)},
+                        {"wheel_readings", out.wheel_readings},
+                        {"ceiling_frames", out.ceiling_frames},
+                        {"omni_frames", out.omni_frames},
+                        {"refused_frames", out.refused_frames},
+                        {"poses_published", c.poses_published},
+                        {"image_to_pose_ms", {{"ceiling", ceiling_ms}, {"omni", omni_ms}}}};
+    json::write_file(a.stats, j.dump(2) + "\n");
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_node_command(CLI::App& app, Job& run) {
+  auto a = std::make_shared<NodeArgs>();
+  CLI::App* c = app.add_subcommand(
+      "node", "The live node: joins a ROS 2 system over DDS (no ROS installation needed)");
+  c->add_option("--robot", a->robot, "robot.json")->required();
+  c->add_option("--map", a->map, "the building's map (GeoJSON)")->required();
+  c->add_option("--domain", a->domain, "ROS 2 domain id (default: ROS_DOMAIN_ID, else 0)")
+      ->check(CLI::Range(0, 232));
+  c->add_option("--initial-pose", a->initial_pose,
+                "X,Y,YAW where the robot starts (m, m, rad); without it the omni camera finds it");
+  ros::NodeTopics& t = a->robot_options.topics;
+  c->add_option("--ceiling-topic", t.ceiling_image,
+                "the ceiling camera's images (CompressedImage when the name ends in /compressed, "
+                "else Image)")
+      ->capture_default_str();
+  c->add_option("--omni-topic", t.omni_image, "the omni camera's images")->capture_default_str();
+  c->add_option("--odometry-topic", t.odometry, "nav_msgs/msg/Odometry")->capture_default_str();
+  c->add_option("--joint-states-topic", t.joint_states,
+                "sensor_msgs/msg/JointState with the two wheel joints, instead of odometry");
+  c->add_option("--left-joint", t.left_joint, "the left wheel's joint (default: named left)");
+  c->add_option("--right-joint", t.right_joint, "the right wheel's joint (default: named right)");
+  c->add_option("--wheel-radius", t.wheel_radius, "with joint states: the wheels' radius (m)")
+      ->check(CLI::PositiveNumber);
+  c->add_option("--command-topic", t.command, "std_msgs/msg/String route commands")
+      ->capture_default_str();
+  c->add_option("--cmd-vel-topic", t.cmd_vel, "geometry_msgs/msg/Twist out")->capture_default_str();
+  c->add_option("--namespace", t.ns, "the node's outputs: pose, mode, hypotheses, events")
+      ->capture_default_str();
+  c->add_flag("--no-ceiling", a->no_ceiling, "do not use the ceiling camera");
+  c->add_flag("--no-omni", a->no_omni, "do not use the omni camera");
+  c->add_option("--idle-exit", a->robot_options.idle_exit_s,
+                "end after this many seconds with no input, once input came (s)")
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--stats", a->stats, "write counts and latencies here (JSON) on exit");
+  c->add_flag("--quiet", a->quiet, "no notes on stderr");
+  c->callback([a, &run] { run = [a] { return run_node(*a); }; });
+}
+
+}  // namespace lampnav::apps

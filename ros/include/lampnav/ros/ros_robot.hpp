@@ -1,0 +1,133 @@
+#pragma once
+// A robot on a ROS 2 system, behind lampnav::Robot: camera images, wheel odometry (or wheel
+// joint states) and route commands come in over DDS; wheel speeds go out as a Twist on /cmd_vel,
+// and the localizer's estimates as the pose, the map -> odom transform, the mode and the
+// hypotheses (docs/ros2.md). Messages are queued by the DDS threads as bytes and decoded on the
+// caller's thread in next(); one that does not decode is counted and reported (topic, message
+// number, field), never fatal.
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <future>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "lampnav/core/robot.hpp"
+#include "lampnav/fusion/localizer.hpp"
+#include "lampnav/io/ros2_messages.hpp"
+#include "lampnav/ros/participant.hpp"
+
+namespace lampnav::ros {
+
+struct NodeTopics {
+  // Images: sensor_msgs/msg/CompressedImage when the name ends in /compressed (image_transport's
+  // convention), else sensor_msgs/msg/Image. Empty: that camera is not used.
+  std::string ceiling_image = "/ceiling_camera/image_raw/compressed";
+  std::string omni_image = "/omni_camera/image_raw/compressed";
+  // Wheel odometry: nav_msgs/msg/Odometry, or, when joint_states is named, the two wheel joints
+  // of sensor_msgs/msg/JointState (found by name as in bags) with the wheel radius.
+  std::string odometry = "/odom";
+  std::string joint_states, left_joint, right_joint;
+  double wheel_radius = 0;
+  std::string command = "/lampnav/command";  // std_msgs/msg/String, route command text
+  std::string cmd_vel = "/cmd_vel";          // geometry_msgs/msg/Twist
+  // Outputs under this namespace: pose, mode, hypotheses, events (and /tf).
+  std::string ns = "/lampnav";
+};
+
+// REP-105 frames.
+struct NodeFrames {
+  std::string map = "map", odom = "odom", base = "base_link";
+};
+
+struct RosRobotOptions {
+  NodeTopics topics;
+  NodeFrames frames;
+  double semi_axis = 0;           // m, from robot.json: odometry poses to wheel travel
+  std::size_t max_queue = 10000;  // messages waiting to be processed; beyond, the oldest image goes
+  double idle_exit_s = 0;         // > 0: next() ends after this long with no input, once one came
+  void validate() const;          // throws InputError naming the option
+};
+
+struct InputCounts {
+  std::uint64_t received = 0, used = 0, refused = 0, dropped = 0;
+};
+
+struct NodeCounts {
+  InputCounts ceiling, omni, odometry, commands;
+  std::uint64_t poses_published = 0;
+};
+
+class RosRobot : public Robot {
+ public:
+  // Subscribes and creates the writers. Throws InputError for bad options or topic names.
+  RosRobot(Participant& participant, const RosRobotOptions& options);
+  ~RosRobot() override;
+
+  void set_wheel_speeds(double left, double right) override;
+  // The next input in arrival order; waits for it. Nullopt after stop(), or after idle_exit_s.
+  std::optional<RobotInput> next() override;
+  // Makes next() return nullopt (from any thread).
+  void stop();
+
+  // Publishes an estimate: the pose and the map -> odom transform when certain; the mode when it
+  // changes; the hypotheses (best first) when they change.
+  void publish(const fusion::LocalizerEstimate& estimate);
+  // A line on <ns>/events (commands taken or refused, the mission's end).
+  void publish_event(const std::string& text);
+
+  // When the input next() last returned arrived (for latency).
+  Clock::time_point last_arrival() const { return last_arrival_; }
+  NodeCounts counts() const;
+  // Called for each message refused, with the reason (topic, message number, field).
+  std::function<void(const std::string&)> on_problem;
+
+ private:
+  enum class Kind { ceiling, omni, odometry, joints, command };
+  // An image decoded (CDR, then PNG or JPEG) on a thread of its own as soon as it arrives, so the
+  // loop never waits for one image's decoding while it could process another input.
+  struct DecodedImage {
+    Stamp capture;
+    Image8 image;
+    std::string problem;
+  };
+  struct Pending {
+    Kind kind;
+    Sample sample;  // its bytes moved to the decoder for images
+    std::future<DecodedImage> image;
+  };
+  DecodedImage decode_image(Kind kind, const std::string& cdr) const;
+  void subscribe(Participant& p, const std::string& topic, const std::string& type, Qos qos,
+                 Kind kind);
+  std::optional<RobotInput> decode(Pending& p);
+  InputCounts& counts_of(Kind kind);
+  const std::string& topic_of(Kind kind) const;
+
+  RosRobotOptions o_;
+  Writer *cmd_vel_, *pose_, *tf_, *mode_, *hypotheses_, *events_;
+
+  mutable std::mutex mutex_;
+  std::condition_variable ready_;
+  std::deque<Pending> queue_;
+  NodeCounts counts_;
+  std::atomic<bool> stop_{false};
+
+  // The loop thread's own.
+  io::ros2::OdometryWheels odometry_wheels_;
+  io::ros2::JointWheels joint_wheels_;
+  std::optional<Stamp> last_wheel_stamp_;
+  // The odometry frame's pose of the base at recent wheel readings, for map -> odom.
+  std::deque<std::pair<Stamp, Pose2>> odom_;
+  std::optional<WheelInput> last_wheels_;
+  Clock::time_point last_arrival_{}, last_input_{};
+  bool any_input_ = false;
+  std::optional<fusion::LocalizerMode> last_mode_;
+  std::size_t last_hypotheses_ = 0;
+  double last_leader_weight_ = -1;
+};
+
+}  // namespace lampnav::ros

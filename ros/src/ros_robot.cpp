@@ -1,0 +1,279 @@
+#include "lampnav/ros/ros_robot.hpp"
+
+#include <cmath>
+
+#include "lampnav/core/error.hpp"
+#include "lampnav/io/mission_log.hpp"
+
+namespace lampnav::ros {
+
+namespace {
+
+bool ends_with(const std::string& s, const std::string& tail) {
+  return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+std::string image_type(const std::string& topic) {
+  return ends_with(topic, "/compressed") ? "sensor_msgs/msg/CompressedImage"
+                                         : "sensor_msgs/msg/Image";
+}
+
+constexpr std::size_t kOdomKept = 400;  // wheel readings (4 s at 100 Hz) for map -> odom
+
+}  // namespace
+
+void RosRobotOptions::validate() const {
+  auto bad = [](const char* field, const std::string& why) {
+    throw InputError({"", "node options", field}, why);
+  };
+  if (!(semi_axis > 0)) bad("semi_axis", "must be positive (robot.json)");
+  if (!topics.joint_states.empty() && !(topics.wheel_radius > 0))
+    bad("wheel-radius", "wheel joint states need the wheel radius (--wheel-radius, m)");
+  if (topics.joint_states.empty() && topics.odometry.empty())
+    bad("odometry-topic", "no wheel odometry topic: name --odometry-topic or --joint-states-topic");
+  if (topics.ceiling_image.empty() && topics.omni_image.empty())
+    bad("ceiling-topic", "neither camera has a topic");
+  if (max_queue < 10) bad("max_queue", "must be at least 10");
+  if (!(idle_exit_s >= 0)) bad("idle-exit", "must not be negative");
+  if (frames.map.empty() || frames.odom.empty() || frames.base.empty())
+    bad("frames", "frame ids must not be empty");
+}
+
+RosRobot::RosRobot(Participant& p, const RosRobotOptions& options)
+    : o_(options), odometry_wheels_(options.semi_axis), joint_wheels_(options.topics.wheel_radius) {
+  o_.validate();
+  const NodeTopics& t = o_.topics;
+  cmd_vel_ = &p.writer(t.cmd_vel, "geometry_msgs/msg/Twist", Qos::state);
+  pose_ = &p.writer(t.ns + "/pose", "geometry_msgs/msg/PoseWithCovarianceStamped", Qos::state);
+  tf_ = &p.writer("/tf", "tf2_msgs/msg/TFMessage", Qos::tf);
+  mode_ = &p.writer(t.ns + "/mode", "std_msgs/msg/String", Qos::state);
+  hypotheses_ = &p.writer(t.ns + "/hypotheses", "geometry_msgs/msg/PoseArray", Qos::state);
+  events_ = &p.writer(t.ns + "/events", "std_msgs/msg/String", Qos::state);
+  if (!t.ceiling_image.empty())
+    subscribe(p, t.ceiling_image, image_type(t.ceiling_image), Qos::sensor_data, Kind::ceiling);
+  if (!t.omni_image.empty())
+    subscribe(p, t.omni_image, image_type(t.omni_image), Qos::sensor_data, Kind::omni);
+  if (!t.joint_states.empty())
+    subscribe(p, t.joint_states, "sensor_msgs/msg/JointState", Qos::sensor_data, Kind::joints);
+  else
+    subscribe(p, t.odometry, "nav_msgs/msg/Odometry", Qos::sensor_data, Kind::odometry);
+  subscribe(p, t.command, "std_msgs/msg/String", Qos::state, Kind::command);
+}
+
+RosRobot::~RosRobot() { stop(); }
+
+void RosRobot::subscribe(Participant& p, const std::string& topic, const std::string& type, Qos qos,
+                         Kind kind) {
+  p.subscribe(topic, type, qos, [this, kind](Sample&& s) {
+    Pending pending{kind, std::move(s), {}};
+    if (kind == Kind::ceiling || kind == Kind::omni)
+      pending.image = std::async(
+          std::launch::async,
+          [this, kind, cdr = std::move(pending.sample.cdr)] { return decode_image(kind, cdr); });
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      ++counts_of(kind).received;
+      queue_.push_back(std::move(pending));
+      if (queue_.size() > o_.max_queue) {
+        // Behind by more than the queue holds: an old image goes first (odometry and commands
+        // are small and each one counts).
+        for (auto it = queue_.begin(); it != queue_.end(); ++it)
+          if (it->kind == Kind::ceiling || it->kind == Kind::omni) {
+            ++counts_of(it->kind).dropped;
+            queue_.erase(it);
+            break;
+          }
+      }
+    }
+    ready_.notify_one();
+  });
+}
+
+InputCounts& RosRobot::counts_of(Kind kind) {
+  switch (kind) {
+    case Kind::ceiling:
+      return counts_.ceiling;
+    case Kind::omni:
+      return counts_.omni;
+    case Kind::command:
+      return counts_.commands;
+    default:
+      return counts_.odometry;
+  }
+}
+
+const std::string& RosRobot::topic_of(Kind kind) const {
+  const NodeTopics& t = o_.topics;
+  switch (kind) {
+    case Kind::ceiling:
+      return t.ceiling_image;
+    case Kind::omni:
+      return t.omni_image;
+    case Kind::odometry:
+      return t.odometry;
+    case Kind::joints:
+      return t.joint_states;
+    default:
+      return t.command;
+  }
+}
+
+NodeCounts RosRobot::counts() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return counts_;
+}
+
+void RosRobot::stop() {
+  stop_ = true;
+  ready_.notify_all();
+}
+
+void RosRobot::set_wheel_speeds(double left, double right) {
+  cmd_vel_->write(io::ros2::twist((left + right) / 2, (right - left) / (2 * o_.semi_axis)));
+}
+
+std::optional<RobotInput> RosRobot::next() {
+  for (;;) {
+    Pending p;
+    {
+      std::unique_lock<std::mutex> lock(mutex_);
+      for (;;) {
+        if (stop_) return std::nullopt;
+        if (!queue_.empty()) break;
+        if (o_.idle_exit_s > 0 && any_input_ &&
+            Clock::now() - last_input_ > std::chrono::duration<double>(o_.idle_exit_s))
+          return std::nullopt;
+        ready_.wait_for(lock, std::chrono::milliseconds(20));
+      }
+      p = std::move(queue_.front());
+      queue_.pop_front();
+    }
+    any_input_ = true;
+    last_input_ = Clock::now();
+    last_arrival_ = p.sample.arrival;
+    std::optional<RobotInput> in;
+    std::string problem;
+    try {
+      in = decode(p);
+    } catch (const io::CdrError& e) {
+      problem = e.what();
+    } catch (const InputError& e) {
+      problem = e.message();
+    }
+    std::lock_guard<std::mutex> lock(mutex_);
+    InputCounts& c = counts_of(p.kind);
+    if (!problem.empty()) {
+      ++c.refused;
+      if (on_problem)
+        on_problem(topic_of(p.kind) + ", message " + std::to_string(p.sample.sequence) + ": " +
+                   problem);
+      continue;
+    }
+    if (!in) continue;  // nothing new (an odometry stamp not later than the last)
+    ++c.used;
+    return in;
+  }
+}
+
+std::optional<RobotInput> RosRobot::decode(Pending& p) {
+  const std::string& cdr = p.sample.cdr;
+  switch (p.kind) {
+    case Kind::ceiling:
+    case Kind::omni: {
+      DecodedImage d = p.image.get();
+      if (!d.problem.empty()) throw io::CdrError(d.problem);
+      FrameInput in;
+      in.camera = p.kind == Kind::ceiling ? CameraRole::ceiling : CameraRole::omni;
+      in.capture = d.capture;
+      // Robot time: the newest wheel reading, or the capture when it is later.
+      in.arrival =
+          last_wheel_stamp_ && *last_wheel_stamp_ > d.capture ? *last_wheel_stamp_ : d.capture;
+      in.image = std::move(d.image);
+      return in;
+    }
+    case Kind::odometry: {
+      const io::OdometryPose o = io::ros2::odometry(cdr);
+      const auto w = odometry_wheels_.add(o);
+      if (!w) return std::nullopt;
+      odom_.emplace_back(o.stamp, o.pose);
+      last_wheel_stamp_ = w->stamp;
+      if (odom_.size() > kOdomKept) odom_.pop_front();
+      return WheelInput{w->stamp, w->left, w->right};
+    }
+    case Kind::joints: {
+      const io::WheelJoints j =
+          io::ros2::wheel_joints(cdr, o_.topics.left_joint, o_.topics.right_joint);
+      const auto w = joint_wheels_.add(j);
+      if (!w) return std::nullopt;
+      // The odometry frame: the wheels integrated (exact arcs).
+      Pose2 pose = odom_.empty() ? Pose2() : odom_.back().second;
+      if (last_wheels_) {
+        const double dl = w->left - last_wheels_->left, dr = w->right - last_wheels_->right;
+        const double ds = (dl + dr) / 2, dyaw = (dr - dl) / (2 * o_.semi_axis);
+        const double chord = std::abs(dyaw) < 1e-9 ? ds : 2 * ds / dyaw * std::sin(dyaw / 2);
+        pose = pose * Pose2(chord * std::cos(dyaw / 2), chord * std::sin(dyaw / 2), dyaw);
+      }
+      last_wheels_ = WheelInput{w->stamp, w->left, w->right};
+      odom_.emplace_back(w->stamp, pose);
+      if (odom_.size() > kOdomKept) odom_.pop_front();
+      last_wheel_stamp_ = w->stamp;
+      return *last_wheels_;
+    }
+    case Kind::command:
+      return CommandInput{last_wheel_stamp_.value_or(Stamp{}), io::ros2::string_data(cdr)};
+  }
+  return std::nullopt;
+}
+
+RosRobot::DecodedImage RosRobot::decode_image(Kind kind, const std::string& cdr) const {
+  DecodedImage d;
+  try {
+    const std::string& topic = topic_of(kind);
+    const io::ImageFrame f = image_type(topic) == "sensor_msgs/msg/Image"
+                                 ? io::ros2::raw_image(cdr)
+                                 : io::ros2::compressed_image(cdr);
+    d.capture = f.stamp;
+    d.image = io::decode_image(f.data, topic);
+  } catch (const io::CdrError& e) {
+    d.problem = e.what();
+  } catch (const InputError& e) {
+    d.problem = e.message();
+  }
+  return d;
+}
+
+void RosRobot::publish(const fusion::LocalizerEstimate& e) {
+  const NodeFrames& f = o_.frames;
+  if (e.known()) {
+    pose_->write(io::ros2::pose_with_covariance_stamped(e.stamp, f.map, e.pose, e.covariance));
+    // map -> odom from the odometry pose at the estimate's wheel reading (or the one before).
+    const std::pair<Stamp, Pose2>* at = nullptr;
+    for (auto it = odom_.rbegin(); it != odom_.rend(); ++it)
+      if (it->first <= e.stamp) {
+        at = &*it;
+        break;
+      }
+    if (at)
+      tf_->write(io::ros2::tf_message({{e.stamp, f.map, f.odom, e.pose * at->second.inverse()}}));
+    std::lock_guard<std::mutex> lock(mutex_);
+    ++counts_.poses_published;
+  }
+  if (!last_mode_ || *last_mode_ != e.mode) {
+    mode_->write(io::ros2::string_message(fusion::to_string(e.mode)));
+    last_mode_ = e.mode;
+  }
+  const double leader = e.hypotheses.empty() ? -1 : e.hypotheses.front().weight;
+  if (e.hypotheses.size() != last_hypotheses_ || leader != last_leader_weight_) {
+    std::vector<Pose2> poses;
+    for (const auto& h : e.hypotheses) poses.push_back(h.pose);
+    hypotheses_->write(io::ros2::pose_array(e.stamp, f.map, poses));
+    last_hypotheses_ = e.hypotheses.size();
+    last_leader_weight_ = leader;
+  }
+}
+
+void RosRobot::publish_event(const std::string& text) {
+  events_->write(io::ros2::string_message(text));
+}
+
+}  // namespace lampnav::ros

@@ -1,0 +1,135 @@
+// lampnav_log_player: plays a recorded mission over DDS as a ROS 2 robot's drivers would (the
+// wheel joints as sensor_msgs/msg/JointState, the cameras as sensor_msgs/msg/CompressedImage,
+// header stamps the capture times), at the pace of the log's arrival times (times --rate), and
+// writes what the node publishes on /lampnav/pose. For the node's tests and benchmark.
+//
+//   lampnav_log_player LOG.mcap --domain D [--rate R] [--wheel-radius M] [--poses OUT]
+//                      [--wait-s S] [--loops N]
+// Prints one line of counts; exit 0, 1 when no node answered, 2 for bad arguments.
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "lampnav/core/error.hpp"
+#include "lampnav/io/mission_log.hpp"
+#include "lampnav/io/ros2_messages.hpp"
+#include "lampnav/ros/participant.hpp"
+#include "player_options.hpp"
+
+using namespace lampnav;
+using Clock = std::chrono::steady_clock;
+
+int main(int argc, char** argv) {
+  test::PlayerOptions o;
+  try {
+    o = test::parse_player_options(argc, argv);
+  } catch (const std::exception& e) {
+    std::cerr << "lampnav_log_player: " << e.what() << "\n";
+    return 2;
+  }
+  const io::MissionLog log = io::read_mission_log(o.log);
+  ros::ParticipantOptions po;
+  po.name = "lampnav_log_player";
+  ros::Participant p(o.domain, po);
+  ros::Writer& joints =
+      p.writer("/joint_states", "sensor_msgs/msg/JointState", ros::Qos::sensor_data);
+  ros::Writer& ceiling = p.writer("/ceiling_camera/image_raw/compressed",
+                                  "sensor_msgs/msg/CompressedImage", ros::Qos::sensor_data);
+  ros::Writer& omni = p.writer("/omni_camera/image_raw/compressed",
+                               "sensor_msgs/msg/CompressedImage", ros::Qos::sensor_data);
+  std::mutex m;
+  std::vector<std::string> poses;
+  std::atomic<long> received{0};
+  std::atomic<std::int64_t> last_pose_ns{0};
+  p.subscribe("/lampnav/pose", "geometry_msgs/msg/PoseWithCovarianceStamped", ros::Qos::state,
+              [&](ros::Sample&& s) {
+                std::lock_guard<std::mutex> lock(m);
+                poses.push_back(std::move(s.cdr));
+                ++received;
+                last_pose_ns = s.arrival.time_since_epoch().count();
+              });
+
+  // The node must be there before anything is played.
+  const auto deadline = Clock::now() + std::chrono::duration<double>(o.wait_s);
+  while (joints.matched() == 0 || ceiling.matched() == 0 || omni.matched() == 0 ||
+         p.publishers_matched("/lampnav/pose") == 0) {
+    if (Clock::now() > deadline) {
+      std::cerr << "lampnav_log_player: no node matched in " << o.wait_s << " s\n";
+      return 1;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+
+  struct Item {
+    Stamp arrival;
+    int kind;  // 0 wheels, 1 ceiling, 2 omni
+    std::size_t index;
+  };
+  std::vector<Item> items;
+  for (std::size_t i = 0; i < log.wheels.size(); ++i)
+    items.push_back({log.wheels[i].log_time, 0, i});
+  for (std::size_t i = 0; i < log.ceiling_images.size(); ++i)
+    items.push_back({log.ceiling_images[i].log_time, 1, i});
+  for (std::size_t i = 0; i < log.omni_images.size(); ++i)
+    items.push_back({log.omni_images[i].log_time, 2, i});
+  std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
+    return a.arrival != b.arrival ? a.arrival < b.arrival : a.kind == 0 && b.kind != 0;
+  });
+
+  long sent[3] = {0, 0, 0}, refused = 0;
+  const Duration span = items.empty() ? Duration(0) : items.back().arrival - items.front().arrival;
+  const auto t0 = Clock::now();
+  for (int loop = 0; loop < o.loops; ++loop) {
+    // Each loop shifts the log's times by its span (and 1 s), so stamps keep increasing.
+    const Duration shift = (span + std::chrono::seconds(1)) * loop;
+    const Stamp first = items.empty() ? Stamp{} : items.front().arrival;
+    for (const Item& it : items) {
+      const double due_s = (to_seconds(it.arrival - first) + to_seconds(shift)) / o.rate;
+      std::this_thread::sleep_until(
+          t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(due_s)));
+      bool ok = false;
+      if (it.kind == 0) {
+        const auto& w = log.wheels[it.index].value;
+        ok = joints.write(io::ros2::joint_state_message(
+            w.stamp + shift, {"left_wheel_joint", "right_wheel_joint"},
+            {w.left / o.wheel_radius, w.right / o.wheel_radius}));
+      } else {
+        const auto& f = (it.kind == 1 ? log.ceiling_images : log.omni_images)[it.index].value;
+        ok = (it.kind == 1 ? ceiling : omni)
+                 .write(io::ros2::compressed_image_message(
+                     f.stamp + shift, it.kind == 1 ? "ceiling_camera" : "omni_camera", f.format,
+                     f.data));
+      }
+      if (ok)
+        ++sent[it.kind];
+      else
+        ++refused;
+    }
+  }
+  const double played_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  // The node's last poses: until none has come for `linger` seconds.
+  for (;;) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const auto last = Clock::time_point(Clock::duration(last_pose_ns.load()));
+    if (Clock::now() - last > std::chrono::duration<double>(o.linger_s)) break;
+  }
+  if (!o.poses.empty()) {
+    std::ofstream out(o.poses);
+    std::lock_guard<std::mutex> lock(m);
+    for (const auto& cdr : poses) out << test::pose_line(cdr) << "\n";
+  }
+  std::cout << "sent " << sent[0] << " joint states, " << sent[1] << " ceiling and " << sent[2]
+            << " omni images in " << played_s << " s (" << refused << " refused); received "
+            << received << " poses\n";
+  return 0;
+}

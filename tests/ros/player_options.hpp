@@ -1,0 +1,72 @@
+#pragma once
+// The log player's command line, and the poses it hears back as text lines.
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+#include "cdr.hpp"  // io's CDR reader (white-box)
+
+namespace lampnav::test {
+
+struct PlayerOptions {
+  std::string log, poses;
+  int domain = 0, loops = 1;
+  double rate = 1, wheel_radius = 0.1, wait_s = 20, linger_s = 3;
+};
+
+inline PlayerOptions parse_player_options(int argc, char** argv) {
+  PlayerOptions o;
+  auto number = [&](int& k) -> double {
+    if (k + 1 >= argc) throw std::invalid_argument(std::string(argv[k]) + " needs a value");
+    const std::string v = argv[++k];
+    std::size_t used = 0;
+    const double x = std::stod(v, &used);
+    if (used != v.size() || !std::isfinite(x) || x < 0)
+      throw std::invalid_argument(std::string(argv[k - 1]) + ": \"" + v + "\" is not a number");
+    return x;
+  };
+  for (int k = 1; k < argc; ++k) {
+    const std::string a = argv[k];
+    if (a == "--domain")
+      o.domain = static_cast<int>(number(k));
+    else if (a == "--rate")
+      o.rate = number(k);
+    else if (a == "--wheel-radius")
+      o.wheel_radius = number(k);
+    else if (a == "--wait-s")
+      o.wait_s = number(k);
+    else if (a == "--linger-s")
+      o.linger_s = number(k);
+    else if (a == "--loops")
+      o.loops = static_cast<int>(number(k));
+    else if (a == "--poses" && k + 1 < argc)
+      o.poses = argv[++k];
+    else if (!a.empty() && a[0] != '-' && o.log.empty())
+      o.log = a;
+    else
+      throw std::invalid_argument("unknown argument " + a);
+  }
+  if (o.log.empty()) throw std::invalid_argument("no log given");
+  if (!(o.rate > 0) || !(o.wheel_radius > 0) || o.loops < 1)
+    throw std::invalid_argument("--rate, --wheel-radius and --loops must be positive");
+  return o;
+}
+
+// geometry_msgs/msg/PoseWithCovarianceStamped as "stamp_ns x y yaw".
+inline std::string pose_line(const std::string& cdr) {
+  io::CdrReader r(cdr);
+  const std::int64_t sec = r.i32("sec"), nsec = r.u32("nanosec");
+  r.string("frame_id");
+  const double x = r.f64("x"), y = r.f64("y");
+  r.f64("z");
+  const double qx = r.f64("qx"), qy = r.f64("qy"), qz = r.f64("qz"), qw = r.f64("qw");
+  const double yaw = std::atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz));
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%lld %.12f %.12f %.12f",
+                static_cast<long long>(sec * 1'000'000'000 + nsec), x, y, yaw);
+  return buf;
+}
+
+}  // namespace lampnav::test
