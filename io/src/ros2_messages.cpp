@@ -50,10 +50,12 @@ ImageFrame compressed_image(const std::string& data) {
   return f;
 }
 
-// sensor_msgs/msg/Image: grey from the supported encodings, kept as a fast PNG.
-ImageFrame raw_image(const std::string& data) {
+GreyImage raw_image_grey(const std::string& data) {
   CdrReader r(data);
-  ImageFrame f = header(r).frame();
+  const Header h = header(r);
+  GreyImage f;
+  f.stamp = h.stamp;
+  f.frame_id = h.frame_id;
   const std::uint32_t height = r.u32("height"), width = r.u32("width");
   const std::string encoding = r.string("encoding");
   const bool big_endian = r.u8("is_bigendian") != 0;
@@ -100,8 +102,17 @@ ImageFrame raw_image(const std::string& data) {
       }
     }
   }
+  f.image = std::move(grey);
+  return f;
+}
+
+ImageFrame raw_image(const std::string& data) {
+  GreyImage g = raw_image_grey(data);
+  ImageFrame f;
+  f.stamp = g.stamp;
+  f.frame_id = std::move(g.frame_id);
   f.format = "png";
-  f.data = encode_png(grey, 1);
+  f.data = encode_png(g.image, 1);
   return f;
 }
 
@@ -131,6 +142,8 @@ WheelJoints wheel_joints(const std::string& data, const std::string& left_name,
   w.stamp = header(r).stamp;
   const std::vector<std::string> names = r.strings("name");
   const std::vector<double> position = r.f64s("position");
+  r.f64s("velocity");  // read to check the message is whole
+  r.f64s("effort");
   if (position.size() != names.size())
     throw CdrError("position holds " + std::to_string(position.size()) + " values for " +
                    std::to_string(names.size()) + " names");

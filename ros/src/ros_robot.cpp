@@ -229,11 +229,15 @@ RosRobot::DecodedImage RosRobot::decode_image(Kind kind, const std::string& cdr)
   DecodedImage d;
   try {
     const std::string& topic = topic_of(kind);
-    const io::ImageFrame f = image_type(topic) == "sensor_msgs/msg/Image"
-                                 ? io::ros2::raw_image(cdr)
-                                 : io::ros2::compressed_image(cdr);
-    d.capture = f.stamp;
-    d.image = io::decode_image(f.data, topic);
+    if (image_type(topic) == "sensor_msgs/msg/Image") {
+      io::ros2::GreyImage g = io::ros2::raw_image_grey(cdr);
+      d.capture = g.stamp;
+      d.image = std::move(g.image);
+    } else {
+      const io::ImageFrame f = io::ros2::compressed_image(cdr);
+      d.capture = f.stamp;
+      d.image = io::decode_image(f.data, topic);
+    }
   } catch (const io::CdrError& e) {
     d.problem = e.what();
   } catch (const InputError& e) {

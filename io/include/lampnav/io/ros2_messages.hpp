@@ -32,6 +32,13 @@ ImageFrame compressed_image(const std::string& cdr);
 // sensor_msgs/msg/Image (mono8, mono16, bgr8, rgb8, bgra8, rgba8; any step): grey, kept as a
 // fast PNG.
 ImageFrame raw_image(const std::string& cdr);
+// The same as grey pixels, for a live node that has no use for the PNG.
+struct GreyImage {
+  Stamp stamp;
+  std::string frame_id;
+  Image8 image;
+};
+GreyImage raw_image_grey(const std::string& cdr);
 // nav_msgs/msg/Odometry: the planar pose (yaw from the quaternion).
 OdometryPose odometry(const std::string& cdr);
 // sensor_msgs/msg/JointState: the positions of the two wheel joints, as named, or else the one

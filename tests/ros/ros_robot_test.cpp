@@ -1,0 +1,168 @@
+// The robot behind DDS, in one process with a stand-in for the robot's drivers on the same
+// domain: its inputs in, a damaged message refused with the topic and field while the next one
+// is taken, wheel speeds out as a Twist, an estimate out as the pose and map -> odom.
+
+#include <mutex>
+
+#include "cdr.hpp"
+#include "lampnav/io/ros2_messages.hpp"
+#include "lampnav/ros/ros_robot.hpp"
+#include "lampnav_test.hpp"
+#include "ros_test_support.hpp"
+
+namespace lampnav::ros {
+namespace {
+
+using ::testing::HasSubstr;
+
+Stamp at(double s) { return stamp_from_nanoseconds(static_cast<std::int64_t>(s * 1e9)); }
+
+// The messages a stand-in subscriber heard on one topic.
+struct Heard {
+  std::mutex m;
+  std::vector<std::string> cdr;
+  std::size_t size() {
+    std::lock_guard<std::mutex> lock(m);
+    return cdr.size();
+  }
+  std::string at(std::size_t k) {
+    std::lock_guard<std::mutex> lock(m);
+    return cdr.at(k);
+  }
+};
+
+TEST(RosRobot, TakesInputsRefusesDamagedOnesAndPublishes) {
+  const int domain = test::test_domain();
+  Participant node_side(domain), drivers(domain);
+  RosRobotOptions o;
+  o.semi_axis = 0.2;
+  o.topics.ceiling_image = "/ceiling_camera/image_raw";  // raw sensor_msgs/msg/Image
+  o.topics.omni_image.clear();
+  RosRobot robot(node_side, o);
+  std::vector<std::string> problems;
+  robot.on_problem = [&](const std::string& p) { problems.push_back(p); };
+
+  Writer& odom = drivers.writer("/odom", "nav_msgs/msg/Odometry", Qos::sensor_data);
+  Writer& camera =
+      drivers.writer("/ceiling_camera/image_raw", "sensor_msgs/msg/Image", Qos::sensor_data);
+  Writer& command = drivers.writer("/lampnav/command", "std_msgs/msg/String", Qos::state);
+  Heard cmd_vel, pose, tf, mode;
+  auto listen = [&](const char* topic, const char* type, Qos q, Heard& h) {
+    drivers.subscribe(topic, type, q, [&h](Sample&& s) {
+      std::lock_guard<std::mutex> lock(h.m);
+      h.cdr.push_back(std::move(s.cdr));
+    });
+  };
+  listen("/cmd_vel", "geometry_msgs/msg/Twist", Qos::state, cmd_vel);
+  listen("/lampnav/pose", "geometry_msgs/msg/PoseWithCovarianceStamped", Qos::state, pose);
+  listen("/tf", "tf2_msgs/msg/TFMessage", Qos::tf, tf);
+  listen("/lampnav/mode", "std_msgs/msg/String", Qos::state, mode);
+  ASSERT_TRUE(test::wait_for([&] {
+    return odom.matched() && camera.matched() && command.matched() &&
+           drivers.publishers_matched("/cmd_vel") && drivers.publishers_matched("/tf") &&
+           drivers.publishers_matched("/lampnav/pose") &&
+           drivers.publishers_matched("/lampnav/mode");
+  })) << "the two participants did not find each other";
+
+  ASSERT_TRUE(odom.write(io::ros2::odometry_message(at(1), "odom", "base_link", Pose2(0, 0, 0))));
+  const std::string good = io::ros2::odometry_message(at(2), "odom", "base_link", Pose2(1, 0, 0));
+  ASSERT_TRUE(odom.write(good.substr(0, 60)));  // cut short
+  ASSERT_TRUE(odom.write(good));
+  io::CdrWriter image;
+  image.header(to_nanoseconds(at(1.5)), "ceiling_camera")
+      .u32(3)
+      .u32(4)
+      .string("mono8")
+      .u8(0)
+      .u32(6);
+  image.bytes(
+      std::string("\x01\x02\x03\x04\xAA\xAA\x05\x06\x07\x08\xAA\xAA\x09\x0A\x0B\x0C\xAA\xAA", 18));
+  ASSERT_TRUE(camera.write(image.take()));
+  ASSERT_TRUE(command.write(io::ros2::string_message("follow the corridor")));
+
+  std::vector<WheelInput> wheels;
+  std::vector<FrameInput> frames;
+  std::vector<CommandInput> commands;
+  std::thread stopper([&] {
+    test::wait_for([&] { return false; }, 3);
+    robot.stop();
+  });
+  while (auto in = robot.next()) {
+    if (auto* w = std::get_if<WheelInput>(&*in)) wheels.push_back(*w);
+    if (auto* f = std::get_if<FrameInput>(&*in)) frames.push_back(*f);
+    if (auto* c = std::get_if<CommandInput>(&*in)) commands.push_back(*c);
+  }
+  stopper.join();
+
+  ASSERT_EQ(wheels.size(), 2u);
+  EXPECT_EQ(wheels[0].stamp, at(1));
+  EXPECT_EQ(wheels[1].stamp, at(2));
+  EXPECT_DOUBLE_EQ(wheels[1].left, 1.0);
+  EXPECT_DOUBLE_EQ(wheels[1].right, 1.0);
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_THAT(problems[0], HasSubstr("/odom, message 2: field"));
+  ASSERT_EQ(frames.size(), 1u);
+  EXPECT_EQ(frames[0].capture, at(1.5));
+  ASSERT_EQ(frames[0].image.width, 4);
+  ASSERT_EQ(frames[0].image.height, 3);
+  EXPECT_EQ(frames[0].image.at(3, 2), 0x0C);  // the row padding skipped
+  ASSERT_EQ(commands.size(), 1u);
+  EXPECT_EQ(commands[0].text, "follow the corridor");
+  const NodeCounts n = robot.counts();
+  EXPECT_EQ(n.odometry.received, 3u);
+  EXPECT_EQ(n.odometry.refused, 1u);
+  EXPECT_EQ(n.ceiling.used, 1u);
+
+  // Wheel speeds out: forward 0.4 m/s, turning 0.2 / (2 x 0.2) = 0.5 rad/s.
+  robot.set_wheel_speeds(0.3, 0.5);
+  ASSERT_TRUE(test::wait_for([&] { return cmd_vel.size() == 1; }));
+  const std::string twist_cdr = cmd_vel.at(0);  // the reader keeps a reference
+  io::CdrReader twist(twist_cdr);
+  EXPECT_DOUBLE_EQ(twist.f64("linear.x"), 0.4);
+  twist.f64("linear.y");
+  twist.f64("linear.z");
+  twist.f64("angular.x");
+  twist.f64("angular.y");
+  EXPECT_DOUBLE_EQ(twist.f64("angular.z"), 0.5);
+
+  // An estimate at the last wheel reading: the pose, and map -> odom = map_base * odom_base^-1
+  // with the odometry's own pose (1, 0, 0) there.
+  fusion::LocalizerEstimate e;
+  e.stamp = at(2);
+  e.pose = Pose2(5, 5, M_PI / 2);
+  e.mode = fusion::LocalizerMode::tracking;
+  robot.publish(e);
+  e.mode = fusion::LocalizerMode::ambiguous;  // not certain: no pose, no transform
+  robot.publish(e);
+  ASSERT_TRUE(
+      test::wait_for([&] { return pose.size() == 1 && tf.size() == 1 && mode.size() == 2; }));
+  test::wait_for([&] { return pose.size() > 1; }, 0.3);
+  EXPECT_EQ(pose.size(), 1u);
+  EXPECT_EQ(io::ros2::string_data(mode.at(1)), "ambiguous");
+  const std::string tf_cdr = tf.at(0);
+  io::CdrReader t(tf_cdr);
+  EXPECT_EQ(t.u32("transforms"), 1u);
+  EXPECT_EQ(t.i32("sec"), 2);
+  t.u32("nanosec");
+  EXPECT_EQ(t.string("frame_id"), "map");
+  EXPECT_EQ(t.string("child_frame_id"), "odom");
+  const double x = t.f64("x"), y = t.f64("y");
+  EXPECT_NEAR(x, 5, 1e-12);  // (5, 5, 90 deg) * (1, 0, 0)^-1 = (5, 4, 90 deg)
+  EXPECT_NEAR(y, 4, 1e-12);
+  EXPECT_EQ(robot.counts().poses_published, 1u);
+}
+
+TEST(RosRobot, RefusesOptionsThatCannotWork) {
+  Participant p(test::test_domain());
+  RosRobotOptions o;
+  EXPECT_THROW(RosRobot(p, o), InputError);  // no semi-axis
+  o.semi_axis = 0.2;
+  o.topics.joint_states = "/joint_states";  // joints without a radius
+  EXPECT_THROW(RosRobot(p, o), InputError);
+  o.topics.joint_states.clear();
+  o.topics.odometry = "odom";  // not a ROS 2 topic name
+  EXPECT_THROW(RosRobot(p, o), InputError);
+}
+
+}  // namespace
+}  // namespace lampnav::ros

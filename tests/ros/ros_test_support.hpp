@@ -1,0 +1,25 @@
+#pragma once
+// Shared by the ros tests: a DDS domain of the test's own, and waiting with a deadline.
+
+#include <unistd.h>
+
+#include <chrono>
+#include <functional>
+#include <thread>
+
+namespace lampnav::test {
+
+// A domain no other test process uses at the same time (ctest runs tests in parallel).
+inline int test_domain() { return 1 + static_cast<int>(::getpid() % 230); }
+
+// Waits until `done` or `seconds` pass; whether it was done.
+inline bool wait_for(const std::function<bool()>& done, double seconds = 10) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return true;
+}
+
+}  // namespace lampnav::test
