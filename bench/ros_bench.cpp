@@ -1,0 +1,88 @@
+// The live node on DDS (issue 16's targets): `lampnav node` fed over the loopback by a player
+// process that plays the recorded corridor run at 3.05 times its pace, so the ceiling camera
+// comes at 30 Hz, the wheels at 150 Hz and the omni camera at 3 Hz, as compressed images (PNG)
+// and joint states. The node times each image from its arrival (handed over by DDS) to the pose
+// it publishes after it (decoding included); the player counts what it sent, the node what it
+// received. The iteration time is the ceiling camera's p99; the rest are counters.
+//   Targets: image in to pose out at most 5 ms (p99); no message lost.
+
+#include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+
+#include "lampnav/graph/geojson.hpp"
+#include "lampnav/io/mission_log.hpp"
+#include "lampnav/sim/scenario.hpp"
+
+namespace {
+
+using namespace lampnav;
+namespace fs = std::filesystem;
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+void BM_NodeImageToPose(benchmark::State& state) {
+  const std::string src = LAMPNAV_SOURCE_DIR;
+  const std::string dir =
+      (fs::temp_directory_path() / ("lampnav_ros_bench_" + std::to_string(::getpid()))).string();
+  fs::create_directories(dir);
+  const std::string text = slurp(src + "/maps/office_floor.geojson");
+  const graph::TopologicalMap map = graph::parse_map(text, "office_floor.geojson").map;
+  const RobotDescription robot = read_robot_description(src + "/maps/robots/pioneer.json");
+  const std::string log = dir + "/corridor.mcap";
+  sim::record_mission(sim::make_named_scenario("corridor", map, text, robot, 1), log);
+  const io::MissionLog mission = io::read_mission_log(log);
+  const double messages = static_cast<double>(mission.wheels.size() +
+                                              mission.ceiling_images.size() +
+                                              mission.omni_images.size());
+  const std::string domain = std::to_string(1 + ::getpid() % 230);
+  for (auto _ : state) {
+    fs::remove(dir + "/stats.json");
+    const std::string node = std::string(LAMPNAV_BINARY) + " node --robot " + src +
+                             "/maps/robots/pioneer.json --map " + src +
+                             "/maps/office_floor.geojson --domain " + domain +
+                             " --joint-states-topic /joint_states --wheel-radius 0.1"
+                             " --idle-exit 3 --quiet --stats " + dir + "/stats.json > " + dir +
+                             "/node.out 2>&1 &";
+    const std::string player = std::string(LAMPNAV_LOG_PLAYER) + " " + log + " --domain " +
+                               domain + " --rate 3.05 --wheel-radius 0.1 > " + dir +
+                               "/player.out 2>&1";
+    if (std::system(node.c_str()) != 0 || std::system(player.c_str()) != 0) {
+      state.SkipWithError(("the node or the player failed: " + slurp(dir + "/player.out")).c_str());
+      break;
+    }
+    for (int k = 0; k < 300 && !fs::exists(dir + "/stats.json"); ++k) ::usleep(100000);
+    ::usleep(300000);
+    nlohmann::json s;
+    try {
+      s = nlohmann::json::parse(slurp(dir + "/stats.json"));
+    } catch (const std::exception&) {
+      state.SkipWithError(("no statistics from the node: " + slurp(dir + "/node.out")).c_str());
+      break;
+    }
+    const auto& ms = s["image_to_pose_ms"];
+    state.SetIterationTime(ms["ceiling"]["p99"].get<double>() / 1000);
+    state.counters["ceiling_p50_ms"] = ms["ceiling"]["p50"].get<double>();
+    state.counters["ceiling_p99_ms"] = ms["ceiling"]["p99"].get<double>();
+    state.counters["omni_p50_ms"] = ms["omni"]["p50"].get<double>();
+    state.counters["omni_p99_ms"] = ms["omni"]["p99"].get<double>();
+    const double received = s["odometry"]["used"].get<double>() +
+                            s["ceiling"]["used"].get<double>() + s["omni"]["used"].get<double>();
+    state.counters["messages"] = messages;
+    state.counters["lost"] = messages - received;
+  }
+  fs::remove_all(dir);
+}
+BENCHMARK(BM_NodeImageToPose)->Iterations(1)->UseManualTime()->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
