@@ -141,8 +141,8 @@ std::optional<double> counter(const std::string& bench, const std::string& name,
 
 // A count that must stay at or below `max_value` (messages lost).
 void add_count(const std::string& what, std::optional<double> v, double max_value) {
-  Row r{what, v ? std::to_string(static_cast<long long>(*v)) : "not run", "", "",
-        "<= " + std::to_string(static_cast<long long>(max_value)), ""};
+  Row r{what, v ? std::to_string(static_cast<long long>(*v)) : "not run", "",
+        "",   "<= " + std::to_string(static_cast<long long>(max_value)),  ""};
   r.verdict = v && *v <= max_value ? "met" : "MISSED";
   rows.push_back(r);
   out_rows.push_back({{"case", what},
@@ -285,15 +285,16 @@ int main(int argc, char** argv) {
   grows("replay", "BM_ReplayBuildingMission");
   add("map build from a recorded 10-minute drive (100-node building)", us("BM_MapBuildFromLog"), "",
       std::nullopt, 20e6, std::nullopt);
-  for (const char* camera : {"ceiling", "omni"})
-    for (const char* q : {"p50", "p99"})
-      add(std::string("node: ") + camera + " image in to pose out, " + q +
-              " (30 Hz images, 150 Hz odometry)",
-          counter("BM_NodeImageToPose", std::string(camera) + "_" + q + "_ms", 1000), "",
-          std::nullopt, std::string(q) == "p99" ? std::optional<double>(5000) : std::nullopt,
-          std::nullopt);
-  add_count("node: messages lost of those sent (one run)",
-            counter("BM_NodeImageToPose", "lost", 1), 0);
+  for (const auto& [arg, format] : {std::pair{"0", "PNG"}, {"90", "JPEG 90"}}) {
+    const std::string bench = std::string("BM_NodeImageToPose/") + arg;
+    for (const char* camera : {"ceiling", "omni"})
+      for (const char* q : {"p50", "p99"})
+        add(std::string("node: ") + camera + " image (" + format + ") in to pose out, " + q,
+            counter(bench, std::string(camera) + "_" + q + "_ms", 1000), "", std::nullopt,
+            std::string(q) == "p99" ? std::optional<double>(5000) : std::nullopt, std::nullopt);
+    add_count(std::string("node: messages lost (") + format + ", 30 Hz images, 150 Hz odometry)",
+              counter(bench, "lost", 1), 0);
+  }
   for (const auto& [n, count] : {std::pair{"10", "100"}, {"100", "100"}, {"1000", "10"}})
     add_battery(std::string("kidnaps (") + count + "), " + n + "-node building",
                 std::string("BM_KidnapBattery/") + n + "/" + count, true);

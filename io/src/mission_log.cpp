@@ -93,6 +93,14 @@ std::string encode_png(const Image8& image, int compression) {
   return std::string(buf.begin(), buf.end());
 }
 
+std::string encode_jpeg(const Image8& image, int quality) {
+  const cv::Mat m(image.height, image.width, CV_8UC1,
+                  const_cast<std::uint8_t*>(image.pixels.data()));
+  std::vector<uchar> buf;
+  cv::imencode(".jpg", m, buf, {cv::IMWRITE_JPEG_QUALITY, quality});
+  return std::string(buf.begin(), buf.end());
+}
+
 Image8 decode_image(const std::string& bytes, const std::string& source) {
   if (bytes.empty()) throw InputError({source, "", ""}, "empty image");
   const std::vector<uchar> buf(bytes.begin(), bytes.end());

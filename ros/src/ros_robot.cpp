@@ -171,6 +171,7 @@ std::optional<RobotInput> RosRobot::next() {
     }
     if (!in) continue;  // nothing new (an odometry stamp not later than the last)
     ++c.used;
+    last_ready_ = Clock::now();
     return in;
   }
 }

@@ -4,7 +4,7 @@
 // writes what the node publishes on /lampnav/pose. For the node's tests and benchmark.
 //
 //   lampnav_log_player LOG.mcap --domain D [--rate R] [--wheel-radius M] [--poses OUT]
-//                      [--wait-s S] [--loops N]
+//                      [--wait-s S] [--loops N] [--jpeg QUALITY]
 // Prints one line of counts; exit 0, 1 when no node answered, 2 for bad arguments.
 
 #include <algorithm>
@@ -36,7 +36,13 @@ int main(int argc, char** argv) {
     std::cerr << "lampnav_log_player: " << e.what() << "\n";
     return 2;
   }
-  const io::MissionLog log = io::read_mission_log(o.log);
+  io::MissionLog log = io::read_mission_log(o.log);
+  if (o.jpeg_quality > 0)
+    for (auto* frames : {&log.ceiling_images, &log.omni_images})
+      for (auto& f : *frames) {
+        f.value.data = io::encode_jpeg(io::decode_image(f.value.data, o.log), o.jpeg_quality);
+        f.value.format = "jpeg";
+      }
   ros::ParticipantOptions po;
   po.name = "lampnav_log_player";
   ros::Participant p(o.domain, po);

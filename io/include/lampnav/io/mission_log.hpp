@@ -253,6 +253,8 @@ std::string base64_decode(const std::string& text);
 
 // PNG for grey images (OpenCV's codec, kept out of this header).
 std::string encode_png(const Image8& image, int compression = 3);
+// JPEG (baseline, grey) at `quality` 1..100.
+std::string encode_jpeg(const Image8& image, int quality);
 // Decodes PNG or JPEG bytes to grey (colour is converted); throws InputError(`source`) when the
 // bytes are not an image.
 Image8 decode_image(const std::string& bytes, const std::string& source);

@@ -80,8 +80,10 @@ class RosRobot : public Robot {
   // A line on <ns>/events (commands taken or refused, the mission's end).
   void publish_event(const std::string& text);
 
-  // When the input next() last returned arrived (for latency).
+  // When the input next() last returned arrived (for latency), and when it was ready (decoded):
+  // from arrival to ready is decoding and queueing, from ready on the stack's processing.
   Clock::time_point last_arrival() const { return last_arrival_; }
+  Clock::time_point last_ready() const { return last_ready_; }
   NodeCounts counts() const;
   // Called for each message refused, with the reason (topic, message number, field).
   std::function<void(const std::string&)> on_problem;
@@ -123,7 +125,7 @@ class RosRobot : public Robot {
   // The odometry frame's pose of the base at recent wheel readings, for map -> odom.
   std::deque<std::pair<Stamp, Pose2>> odom_;
   std::optional<WheelInput> last_wheels_;
-  Clock::time_point last_arrival_{}, last_input_{};
+  Clock::time_point last_arrival_{}, last_ready_{}, last_input_{};
   bool any_input_ = false;
   std::optional<fusion::LocalizerMode> last_mode_;
   std::size_t last_hypotheses_ = 0;
