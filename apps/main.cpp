@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 #include <vector>
@@ -89,6 +90,46 @@ void add_bag_topic_options(CLI::App& command, io::BagTopics& topics) {
       ->check(CLI::PositiveNumber);
 }
 
+namespace {
+
+std::string triple(const Eigen::Vector3d& v) {
+  std::ostringstream s;
+  s << std::setprecision(4) << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
+  return s.str();
+}
+
+// A bag's transforms (/tf_static, /tf) give the cameras' mounts where they join the base to the
+// frame its images are stamped with; robot.json's mounts stay where they do not.
+void mounts_from_tf(const io::MissionLog& log, const std::string& log_path, RobotDescription& robot,
+                    std::string* robot_text) {
+  if (log.transforms.empty()) return;
+  bool changed = false;
+  for (auto& c : robot.cameras) {
+    const auto& frames = c.name == "ceiling_camera" ? log.ceiling_images : log.omni_images;
+    if ((c.name != "ceiling_camera" && c.name != "omni_camera") || frames.empty()) continue;
+    const std::string& frame = frames.front().value.frame_id;
+    const auto m = io::mount_from_tf(log, frame);
+    if (!m) {
+      diagnostic("note", log_path + ": no transform joins base_footprint or base_link to " + frame +
+                             ": " + c.name + "'s mount from robot.json");
+      continue;
+    }
+    diagnostic(
+        "note",
+        log_path + ": " + c.name + " mount from the bag's transforms (" + m->base + " -> " + frame +
+            "): xyz " + triple(m->xyz) + ", rpy " + triple(m->rpy) + " (robot.json: xyz " +
+            triple(c.mount.xyz) + ", rpy " + triple(c.mount.rpy) + ")" +
+            (m->base == "base_link" ? "; lampnav's base is on the floor: base_link must be too"
+                                    : ""));
+    c.mount.xyz = m->xyz;
+    c.mount.rpy = m->rpy;
+    changed = true;
+  }
+  if (changed && robot_text) *robot_text = to_robot_json(robot);
+}
+
+}  // namespace
+
 io::MissionLog read_log_for_robot(const std::string& log_path, const std::string& robot_path,
                                   const io::BagTopics& topics, RobotDescription& robot,
                                   std::string* robot_text) {
@@ -104,6 +145,7 @@ io::MissionLog read_log_for_robot(const std::string& log_path, const std::string
                          "(sensor_msgs/msg/JointState): give --wheel-radius");
       io::wheels_from_joints(log, topics.wheel_radius);
     }
+    mounts_from_tf(log, log_path, robot, robot_text);
   }
   return log;
 }

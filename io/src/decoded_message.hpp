@@ -4,6 +4,7 @@
 
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "lampnav/io/mcap.hpp"
 #include "lampnav/io/mission_log.hpp"
@@ -22,6 +23,7 @@ struct DecodedMessage {
     odometry,
     joints,
     camera_info,
+    transforms,
     bad,
   } kind = Kind::none;
   Logged<WheelReading> wheel;
@@ -32,6 +34,7 @@ struct DecodedMessage {
   Logged<OdometryPose> odometry;
   Logged<WheelJoints> joints;
   std::unique_ptr<CameraInfo> camera_info;  // with its topic in `topic` (rare, and large)
+  std::vector<FrameTransform> transforms;
   std::string topic;
   std::string problem;  // bad: what, naming the topic and the message
 };

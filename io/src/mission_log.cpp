@@ -494,6 +494,9 @@ void keep(DecodedMessage& d, MissionLog& log) {
     case Kind::joints:
       log.wheel_joints.push_back(std::move(d.joints));
       break;
+    case Kind::transforms:
+      for (auto& t : d.transforms) log.transforms.push_back(std::move(t));
+      break;
     case Kind::camera_info:
       log.camera_info[d.topic] = std::move(*d.camera_info);
       break;

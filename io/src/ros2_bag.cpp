@@ -2,11 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "cdr.hpp"
-#include "lampnav/io/ros2_messages.hpp"
 #include "lampnav/core/error.hpp"
+#include "lampnav/io/ros2_messages.hpp"
 
 namespace lampnav::io {
 
@@ -144,7 +145,8 @@ void decode_ros2(const Ros2Channels& c, const McapChannel& ch, const McapMessage
   const Stamp avail = stamp_from_nanoseconds(static_cast<std::int64_t>(m.log_time));
   try {
     if (&ch == c.ceiling || &ch == c.omni) {
-      d.image = {avail, type == "sensor_msgs/Image" ? ros2::raw_image(m.data) : ros2::compressed_image(m.data)};
+      d.image = {avail, type == "sensor_msgs/Image" ? ros2::raw_image(m.data)
+                                                    : ros2::compressed_image(m.data)};
       if (d.image.value.frame_id.empty())
         d.image.value.frame_id = &ch == c.ceiling ? "ceiling_camera" : "omni_camera";
       d.kind = &ch == c.ceiling ? Kind::ceiling : Kind::omni;
@@ -154,6 +156,12 @@ void decode_ros2(const Ros2Channels& c, const McapChannel& ch, const McapMessage
     } else if (&ch == c.joints) {
       d.joints = {avail, ros2::wheel_joints(m.data, c.left_joint, c.right_joint)};
       d.kind = Kind::joints;
+    } else if (type == "tf2_msgs/TFMessage") {
+      d.transforms = ros2::tf_transforms(m.data);
+      const bool is_static =
+          ch.topic.size() >= 9 && ch.topic.compare(ch.topic.size() - 9, 9, "tf_static") == 0;
+      for (auto& t : d.transforms) t.is_static = is_static;
+      d.kind = Kind::transforms;
     } else if (type == "sensor_msgs/CameraInfo") {
       d.camera_info = std::make_unique<CameraInfo>(ros2::camera_info(m.data));
       d.topic = ch.topic;
@@ -192,6 +200,58 @@ void wheels_from_joints(MissionLog& log, double wheel_radius) {
   ros2::JointWheels wheels(wheel_radius);
   for (const auto& j : by_capture(log.wheel_joints))
     if (const auto w = wheels.add(j.value)) log.wheels.push_back({j.log_time, *w});
+}
+
+namespace {
+
+// A frame's pose in the root of its tree, the latest transform of each pair.
+struct InRoot {
+  std::string root;
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  std::vector<std::string> chain;  // the frame, its parent, ..., the root
+};
+
+std::optional<InRoot> in_root(const std::map<std::string, const FrameTransform*>& parent_of,
+                              const std::string& frame) {
+  InRoot r;
+  std::string cur = frame;
+  r.chain.push_back(cur);
+  for (;;) {
+    const auto it = parent_of.find(cur);
+    if (it == parent_of.end()) break;
+    Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
+    t.linear() = it->second->rotation.toRotationMatrix();
+    t.translation() = it->second->translation;
+    r.pose = t * r.pose;
+    cur = it->second->parent;
+    if (std::find(r.chain.begin(), r.chain.end(), cur) != r.chain.end()) return std::nullopt;
+    r.chain.push_back(cur);
+  }
+  r.root = cur;
+  return r;
+}
+
+}  // namespace
+
+std::optional<MountFromTf> mount_from_tf(const MissionLog& log, const std::string& frame) {
+  std::map<std::string, const FrameTransform*> parent_of;  // by child: the latest
+  for (const auto& t : log.transforms) parent_of[t.child] = &t;
+  const auto camera = in_root(parent_of, frame);
+  if (!camera) return std::nullopt;
+  for (const char* base : {"base_footprint", "base_link"}) {
+    const auto b = in_root(parent_of, base);
+    if (!b || b->root != camera->root || frame == base) continue;
+    if (b->chain.size() == 1 && camera->root != base) continue;  // the base is not in the tree
+    const Eigen::Isometry3d m = b->pose.inverse() * camera->pose;
+    MountFromTf out;
+    out.xyz = m.translation();
+    const Eigen::Matrix3d R = m.linear();
+    out.rpy = {std::atan2(R(2, 1), R(2, 2)), std::atan2(-R(2, 0), std::hypot(R(2, 1), R(2, 2))),
+               std::atan2(R(1, 0), R(0, 0))};
+    out.base = base;
+    return out;
+  }
+  return std::nullopt;
 }
 
 }  // namespace lampnav::io

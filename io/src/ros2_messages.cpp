@@ -190,6 +190,32 @@ CameraInfo camera_info(const std::string& data) {
   return c;
 }
 
+std::vector<FrameTransform> tf_transforms(const std::string& data) {
+  CdrReader r(data);
+  // Each element at least: header (8 + 4), child (4), 7 doubles.
+  const std::uint32_t n = r.count("transforms", 12 + 4 + 7 * 8);
+  std::vector<FrameTransform> out(n);
+  for (auto& t : out) {
+    const Header h = header(r);
+    t.stamp = h.stamp;
+    t.parent = h.frame_id;
+    t.child = r.string("child_frame_id");
+    for (int k = 0; k < 3; ++k) t.translation[k] = r.f64("transform.translation");
+    double q[4];
+    for (auto& v : q) v = r.f64("transform.rotation");
+    t.rotation = Eigen::Quaterniond(q[3], q[0], q[1], q[2]);
+    if (!t.translation.allFinite() || !t.rotation.coeffs().allFinite())
+      throw CdrError("transform " + t.parent + " -> " + t.child + " is not finite");
+    if (std::abs(t.rotation.norm() - 1) > 1e-3)
+      throw CdrError("transform " + t.parent + " -> " + t.child +
+                     ": the rotation is not a unit quaternion");
+    if (t.parent.empty() || t.child.empty() || t.parent == t.child)
+      throw CdrError("a transform needs two different frame ids");
+    t.rotation.normalize();
+  }
+  return out;
+}
+
 std::string string_data(const std::string& data) {
   CdrReader r(data);
   return r.string("data");

@@ -380,5 +380,79 @@ TEST(Ros2Bag, CorruptedMessagesAreReadOrSkippedNeverMore) {
   for (const auto& p : log.problems) EXPECT_THAT(p, HasSubstr("(skipped)"));
 }
 
+// tf2_msgs/msg/TFMessage of (parent, child, xyz, quaternion x y z w).
+struct Tf {
+  std::string parent, child;
+  Eigen::Vector3d xyz;
+  Eigen::Quaterniond q;
+};
+std::string tf_cdr(const std::vector<Tf>& tfs) {
+  test::CdrWriter w;
+  w.u32(static_cast<std::uint32_t>(tfs.size()));
+  for (const auto& t : tfs) {
+    w.header(0, t.parent).string(t.child);
+    w.f64(t.xyz.x()).f64(t.xyz.y()).f64(t.xyz.z());
+    w.f64(t.q.x()).f64(t.q.y()).f64(t.q.z()).f64(t.q.w());
+  }
+  return w.data();
+}
+
+Eigen::Quaterniond about(const Eigen::Vector3d& axis, double deg) {
+  return Eigen::Quaterniond(Eigen::AngleAxisd(deg * M_PI / 180, axis));
+}
+
+TEST(Ros2Bag, CameraMountsFromTheBagsTransforms) {
+  Bag bag;
+  bag.topics = {{"/tf_static", "tf2_msgs/msg/TFMessage"}, {"/tf", "tf2_msgs/msg/TFMessage"}};
+  const Eigen::Quaterniond none = Eigen::Quaterniond::Identity();
+  bag.messages.push_back(
+      {0, 1,
+       tf_cdr({{"base_footprint", "base_link", {0, 0, 0.15}, none},
+               {"base_link", "ceiling_mount", {0.1, 0, 0.2}, about(Eigen::Vector3d::UnitZ(), 90)},
+               {"ceiling_mount",
+                "ceiling_optical",
+                {0, 0, 0.05},
+                about(Eigen::Vector3d::UnitY(), 5)}})});
+  // The robot moving in odom does not change where its cameras are on it.
+  for (int k = 0; k < 3; ++k)
+    bag.messages.push_back({1, 2 + std::uint64_t(k),
+                            tf_cdr({{"odom",
+                                     "base_footprint",
+                                     {k * 1.0, 0, 0},
+                                     about(Eigen::Vector3d::UnitZ(), 10 * k)}})});
+  // Refused: not a unit quaternion.
+  bag.messages.push_back(
+      {0, 9, tf_cdr({{"base_link", "omni_optical", {0, 0, 1}, Eigen::Quaterniond(2, 0, 0, 0)}})});
+  const std::string path = bag.write("tf.mcap");
+  const MissionLog log = read_mission_log(path);
+  std::filesystem::remove(path);
+  EXPECT_EQ(log.transforms.size(), 6u);
+  EXPECT_EQ(log.skipped_messages, 1u);
+  ASSERT_FALSE(log.problems.empty());
+  EXPECT_THAT(log.problems.front(), HasSubstr("not a unit quaternion"));
+
+  const auto m = mount_from_tf(log, "ceiling_optical");
+  ASSERT_TRUE(m);
+  EXPECT_EQ(m->base, "base_footprint");
+  EXPECT_TRUE(m->xyz.isApprox(Eigen::Vector3d(0.1, 0, 0.40), 1e-12)) << m->xyz.transpose();
+  EXPECT_NEAR(m->rpy.x(), 0, 1e-12);
+  EXPECT_NEAR(m->rpy.y(), 5 * M_PI / 180, 1e-12);
+  EXPECT_NEAR(m->rpy.z(), M_PI / 2, 1e-12);
+  EXPECT_FALSE(mount_from_tf(log, "omni_optical"));  // its only transform was refused
+  EXPECT_FALSE(mount_from_tf(log, "nowhere"));
+
+  // Without base_footprint, base_link is the base.
+  Bag link;
+  link.topics = {{"/tf_static", "tf2_msgs/msg/TFMessage"}};
+  link.messages.push_back({0, 1, tf_cdr({{"base_link", "cam", {0.2, 0.1, 1.5}, none}})});
+  const std::string p2 = link.write("tf_link.mcap");
+  const MissionLog l2 = read_mission_log(p2);
+  std::filesystem::remove(p2);
+  const auto m2 = mount_from_tf(l2, "cam");
+  ASSERT_TRUE(m2);
+  EXPECT_EQ(m2->base, "base_link");
+  EXPECT_TRUE(m2->xyz.isApprox(Eigen::Vector3d(0.2, 0.1, 1.5), 1e-12));
+}
+
 }  // namespace
 }  // namespace lampnav::io

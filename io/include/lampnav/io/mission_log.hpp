@@ -4,6 +4,7 @@
 // the MCAP log_time is when it became AVAILABLE to the stack.
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <array>
 #include <map>
 #include <memory>
@@ -191,6 +192,15 @@ struct OdometryPose {
   Pose2 pose;
 };
 
+// A transform of a ROS 2 bag's /tf or /tf_static: `child` frame in `parent` frame.
+struct FrameTransform {
+  Stamp stamp;
+  std::string parent, child;
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  Eigen::Quaterniond rotation = Eigen::Quaterniond::Identity();
+  bool is_static = false;  // from /tf_static
+};
+
 // sensor_msgs/msg/CameraInfo, as the bag gave it.
 struct CameraInfo {
   Stamp stamp;
@@ -207,6 +217,7 @@ struct MissionLog {
   std::vector<Logged<OdometryPose>> odometry;     // a ROS 2 bag's (see wheels_from_odometry)
   std::vector<Logged<WheelJoints>> wheel_joints;  // a ROS 2 bag's (see wheels_from_joints)
   std::map<std::string, CameraInfo> camera_info;  // by topic, the last of each
+  std::vector<FrameTransform> transforms;          // a ROS 2 bag's /tf_static and /tf, in order
   std::vector<Logged<ImageFrame>> ceiling_images, omni_images;
   std::vector<Logged<TruthPose>> truth;
   std::vector<Logged<MissionEvent>> events;
@@ -233,6 +244,18 @@ void wheels_from_odometry(MissionLog& log, double semi_axis);
 // A bag's wheel joint positions (rad) as wheel travel (m) for wheels of this radius (m). Nothing
 // is done when the log has wheel readings of its own.
 void wheels_from_joints(MissionLog& log, double wheel_radius);
+
+// The pose of `frame` in lampnav's `base` from a bag's transforms (REP-105: base_footprint, on the
+// floor as lampnav's base is; else base_link, and `note` says so): the chain of transforms from
+// the base to the frame, each the latest of its pair, static or not. A camera's optical frame
+// (z along the optical axis, x to the image's right, y down the image) is lampnav's camera frame,
+// so this is a camera's mount. Nullopt when no chain joins them.
+struct MountFromTf {
+  Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
+  Eigen::Vector3d rpy = Eigen::Vector3d::Zero();  // R = Rz(yaw) Ry(pitch) Rx(roll)
+  std::string base;                               // the base frame used
+};
+std::optional<MountFromTf> mount_from_tf(const MissionLog& log, const std::string& frame);
 
 // The truth of a log at any instant, interpolated between the samples around it. A kidnap is a
 // jump between two samples (more than 0.5 m): no interpolation across it.

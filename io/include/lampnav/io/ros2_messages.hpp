@@ -48,6 +48,8 @@ WheelJoints wheel_joints(const std::string& cdr, const std::string& left_name,
 CameraInfo camera_info(const std::string& cdr);
 // std_msgs/msg/String.
 std::string string_data(const std::string& cdr);
+// tf2_msgs/msg/TFMessage (from /tf or /tf_static).
+std::vector<FrameTransform> tf_transforms(const std::string& cdr);
 
 // --- Encoders (little endian, as ROS 2 writes on x86 and ARM) ---
 
