@@ -7,7 +7,7 @@ JOBS ?= $(shell nproc)
 LAMPNAV := $(BUILD_DIR)/apps/lampnav
 OUT ?= lampnav-out
 
-.PHONY: all deps configure build demo test bench format clean interop-deps
+.PHONY: all deps configure build demo test bench format clean interop-deps test-sanitized fuzz
 
 all: build
 
@@ -35,6 +35,44 @@ interop-deps: deps
 
 test: build interop-deps
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+
+# The whole suite under AddressSanitizer and UndefinedBehaviorSanitizer (GCC; any report fails the
+# test). GCC's warnings change under the sanitizers (false uninitialized warnings in Boost.Graph),
+# so they are not errors in this build.
+SAN_DIR ?= build-asan
+SAN_FLAGS = -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined
+test-sanitized: interop-deps
+	@cmake -S . -B $(SAN_DIR) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLAMPNAV_BUILD_BENCH=OFF \
+	  -DLAMPNAV_WERROR=OFF -DCMAKE_CXX_FLAGS="$(SAN_FLAGS)" \
+	  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
+	@cmake --build $(SAN_DIR) -j $(JOBS)
+	@cd $(SAN_DIR) && ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 \
+	  UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 ctest --output-on-failure -j $(JOBS)
+
+# libFuzzer (clang) on each outside input, FUZZ_SECONDS each (tests/fuzz/, docs/reliability.md).
+# Each starts from its checked-in seeds; what it finds new goes to build-fuzz/corpus/, crashes to
+# build-fuzz/crashes/ (add each as a regression: tests/fuzz/regressions/<harness>/).
+FUZZ_DIR ?= build-fuzz
+FUZZ_SECONDS ?= 60
+FUZZERS = map_geojson robot_json mcap mission_log route_commands image ros2_cdr calibration
+FUZZ_FLAGS = -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer -g
+fuzz: deps
+	@cmake -S . -B $(FUZZ_DIR) -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_C_COMPILER=clang \
+	  -DCMAKE_CXX_COMPILER=clang++ -DLAMPNAV_FUZZ=ON -DLAMPNAV_BUILD_TESTS=OFF \
+	  -DLAMPNAV_BUILD_BENCH=OFF -DLAMPNAV_WERROR=OFF -DCMAKE_CXX_FLAGS="$(FUZZ_FLAGS)" \
+	  -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
+	@cmake --build $(FUZZ_DIR) -j $(JOBS) --target fuzzers
+	@mkdir -p $(FUZZ_DIR)/crashes
+	@set -e; for f in $(FUZZERS); do \
+	  mkdir -p $(FUZZ_DIR)/corpus/$$f; \
+	  echo "fuzz $$f: $(FUZZ_SECONDS) s"; \
+	  ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1 \
+	  $(FUZZ_DIR)/tests/fuzz/fuzz_$$f $(FUZZ_DIR)/corpus/$$f tests/fuzz/corpus/$$f \
+	    -max_total_time=$(FUZZ_SECONDS) -timeout=10 -rss_limit_mb=4096 -max_len=1048576 \
+	    -artifact_prefix=$(FUZZ_DIR)/crashes/$$f- -print_final_stats=1 2>&1 | \
+	    grep -E "^(stat::|==|SUMMARY|#[0-9]+ +DONE|artifact|.*ERROR)" || true; \
+	  if ls $(FUZZ_DIR)/crashes/$$f-* >/dev/null 2>&1; then echo "fuzz $$f: FOUND A FAULT"; exit 1; fi; \
+	done
 
 bench: build
 	@cmake --build $(BUILD_DIR) --target benchmarks

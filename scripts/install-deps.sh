@@ -18,6 +18,8 @@ packages=(
   libfastrtps-dev libfastcdr-dev
   # tests and benchmarks; Chromium opens the report headless in a test
   libgtest-dev libgmock-dev libbenchmark-dev chromium
+  # coverage-guided fuzzing (make fuzz): clang with libFuzzer and the sanitizer runtimes
+  clang libclang-rt-14-dev
 )
 # Node.js and npm run the MCAP interoperability test (@mcap/core). A machine that already has
 # them (from any source) keeps its own.

@@ -13,6 +13,7 @@
 
 #include "global_localizer_impl.hpp"
 #include "lampnav/core/error.hpp"
+#include "spurious_blobs.hpp"
 
 namespace lampnav::fusion {
 
@@ -99,6 +100,7 @@ void GlobalLocalizer::Impl::index_lamps() {
     }
     class_of.push_back(it->second);
   }
+  spurious_limit = spurious_blob_limit(*map, mount_t.z());
   // Two seeds lie within pair_max_theta of the axis: no further apart than twice that reach.
   const double offset = mount_t.head<2>().norm();
   const double reach = max_height * std::tan(q.pair_max_theta_deg * kDeg) + offset;

@@ -97,6 +97,7 @@ struct GlobalLocalizer::Impl {
     double height, length;
   };
   std::vector<LampClass> classes;
+  double spurious_limit = 0;  // spurious_blobs.hpp: blobs too small to be a lamp never seed
   std::vector<int> class_of;  // per lamp
   // Ordered pairs of lamps close enough to be seen together as seeds, grouped by their classes
   // and sorted by horizontal distance: a pair of blobs looks up the pairs spaced like it.

@@ -1,5 +1,7 @@
 #include "lampnav/fusion/kidnap_monitor.hpp"
 
+#include "spurious_blobs.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -44,18 +46,16 @@ void OmniCheckOptions::validate() const {
 
 OmniCheck::OmniCheck(const graph::TopologicalMap& map, const CameraDescription& camera,
                      const OmniCheckOptions& options)
-    : map_(&map), mount_R_(camera.mount.rotation()), mount_t_(camera.mount.xyz), o_(options) {
+    : map_(&map),
+      mount_R_(camera.mount.rotation()),
+      mount_t_(camera.mount.xyz),
+      o_(options),
+      min_blob_per_cos_(detail::spurious_blob_limit(map, camera.mount.xyz.z())) {
   o_.validate();
   if (!is_fisheye(camera.model))
     throw Error("the omni check needs a fisheye camera, '" + camera.name + "' is not");
-  double smallest = 1e9, highest = 0;
   for (const auto& n : map.nodes())
-    for (const auto& l : n.lamps) {
-      lamps_.push_back(&l);
-      smallest = std::min({smallest, l.length, l.width > 0 ? l.width : l.length});
-      highest = std::max(highest, l.xyz.z() - mount_t_.z());
-    }
-  if (highest > 0 && smallest < 1e9) min_blob_per_cos_ = 0.25 * smallest / highest;
+    for (const auto& l : n.lamps) lamps_.push_back(&l);
 }
 
 OmniCheckResult OmniCheck::check(const Pose2& pose, const Eigen::Matrix3d& P,
@@ -101,10 +101,9 @@ OmniCheckResult OmniCheck::check(const Pose2& pose, const Eigen::Matrix3d& P,
     if (!crowded) clear.push_back(p);
   }
   std::vector<const vision::OmniBlob*> used;
-  // Blobs far smaller than any lamp at their angle are spurious lights (a window's glint, a
-  // reflection): they say nothing of where the lamps are.
   for (const auto& b : blobs)
-    if (b.theta <= max_theta + 0.1 && b.angular_radius >= min_blob_per_cos_ * std::cos(b.theta))
+    if (b.theta <= max_theta + 0.1 &&
+        !detail::is_spurious_blob(min_blob_per_cos_, b.theta, b.angular_radius))
       used.push_back(&b);
   r.blobs = static_cast<int>(used.size());
   r.expected = static_cast<int>(clear.size());

@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "global_localizer_impl.hpp"
+#include "spurious_blobs.hpp"
 
 namespace lampnav::fusion {
 
@@ -16,9 +17,12 @@ GlobalLocalizer::Impl::Seeds GlobalLocalizer::Impl::seeds_of(const std::vector<B
                                                              const LampPairOptions& q,
                                                              std::size_t max) const {
   Seeds s;
-  // Nearest the optical axis, where a ray says most about position.
+  // Nearest the optical axis, where a ray says most about position; never a blob too small to be
+  // a lamp (a glint among the few seeds would hide the true pose).
   for (const BlobRay& b : blobs)
-    if (b.theta <= q.pair_max_theta_deg * kDeg && (mount_R * b.ray).z() > 0.05) s.rays.push_back(b);
+    if (b.theta <= q.pair_max_theta_deg * kDeg && (mount_R * b.ray).z() > 0.05 &&
+        !is_spurious_blob(spurious_limit, b.theta, b.angular_radius))
+      s.rays.push_back(b);
   std::sort(s.rays.begin(), s.rays.end(),
             [](const BlobRay& a, const BlobRay& b) { return a.theta < b.theta; });
   if (s.rays.size() > max) s.rays.resize(max);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/vision/camera_models.hpp"
@@ -34,6 +35,8 @@ void LocalizerOptions::validate() const {
   global.validate();
   if (omni_update_min_lamps < 0)
     throw InputError({"", "localizer options", "omni_update_min_lamps"}, "must not be negative");
+  if (!(max_odometry_gap > Duration::zero()))
+    throw InputError({"", "localizer options", "max_odometry_gap"}, "must be positive");
   hypotheses.validate();
 }
 
@@ -156,6 +159,7 @@ struct Localizer::Impl {
 
   // An omni frame while unsure: the hypotheses weighed (and born, while they are not all known).
   void relocalize(Stamp stamp, Localizer& self) {
+    if (before_odometry(stamp)) return;
     ++counts.relocalization_frames;
     hypotheses->omni(stamp, last_omni, odometry);
     settle(stamp, self);
@@ -176,11 +180,37 @@ struct Localizer::Impl {
     if (u.applied() || u.refusal == Refusal::gated) lose(monitor.innovation(u.mahalanobis2));
   }
 
-  void lose(const std::optional<std::string>& why) {
+  // A frame captured before the dead reckoning's first reading (the start, or odometry that stopped
+  // and came back): no hypothesis can be carried to where it was taken, so it weighs none.
+  bool before_odometry(Stamp stamp) {
+    if (!odometry.empty() && stamp >= odometry.first_stamp()) return false;
+    ++counts.frames_too_old;
+    return true;
+  }
+
+  // Odometry stopped and came back (or the clock jumped): where the robot went in between is not
+  // known. Nothing from before can be carried across: the hypotheses go, dead reckoning starts
+  // again from this reading, and the robot is looked for anew.
+  void motion_unknown(double gap_s) {
+    char why[120];
+    std::snprintf(why, sizeof why,
+                  "no wheel odometry for %.1f s: the motion in between is not known", gap_s);
+    hypotheses->clear();
+    odometry = OdometryTrack(o.ekf.semi_axis);
+    ++counts.odometry_gaps;
+    if (unsure())
+      set_mode(LocalizerMode::lost, why);
+    else
+      lose(std::string(why), false);
+  }
+
+  // `keep_estimate`: the estimate tracked until now stays one of the places the robot may be (a
+  // false alarm then costs a few frames, never the pose); not when the motion since it is unknown
+  // (odometry that stopped), where it would only be a likely-looking guess.
+  void lose(const std::optional<std::string>& why, bool keep_estimate = true) {
     if (!why || unsure()) return;
-    // The estimate tracked until now stays one of the places the robot may be: a false alarm
-    // then costs a few frames, never the pose.
-    if (ekf.initialized()) hypotheses->keep(ekf.stamp(), ekf.pose(), ekf.covariance(), odometry);
+    if (keep_estimate && ekf.initialized())
+      hypotheses->keep(ekf.stamp(), ekf.pose(), ekf.covariance(), odometry);
     refresh_status();  // not the last loss's verdict
     set_mode(LocalizerMode::lost, *why);
   }
@@ -255,6 +285,7 @@ struct Localizer::Impl {
       ++counts.ceiling_frames;
       ++counts.frames_while_lost;
       if (hs.empty()) return last_ceiling;
+      if (before_odometry(stamp)) return last_ceiling;
       std::vector<vision::LampDetection> lamps;
       for (const auto& l : last_ceiling.lamps) lamps.push_back(l.detection);
       hypotheses->ceiling(stamp, lamps, odometry);
@@ -297,7 +328,9 @@ std::optional<Refusal> Localizer::wheels(Stamp stamp, double left, double right)
   const auto [left0, right0] = m.last_wheels.value_or(std::pair{left, right});
   const double dl = left - left0, dr = right - right0;
   const auto [cl, cr] = m.calibration.correct(dl, dr);
+  const bool gap = !m.odometry.empty() && stamp - m.odometry.last_stamp() > m.o.max_odometry_gap;
   const auto r = m.ekf.predict(stamp, cl, cr);
+  if (gap) m.motion_unknown(to_seconds(stamp - m.odometry.last_stamp()));
   if (!r || *r == Refusal::not_initialized) {
     // Before the first pose the readings still count: relocalization dead-reckons with them.
     m.last_wheels = {left, right};

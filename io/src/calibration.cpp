@@ -195,7 +195,10 @@ CameraDescription camera(const std::string& model, const std::vector<double>& d,
 }  // namespace
 
 std::vector<ImportedCamera> read_calibration(const std::string& path) {
-  const std::string data = json::read_file(path);
+  return parse_calibration(json::read_file(path), path);
+}
+
+std::vector<ImportedCamera> parse_calibration(const std::string& data, const std::string& path) {
   Node root;
   const bool opencv = data.rfind("%YAML:1.", 0) == 0 ||
                       (data.find("<?xml") != std::string::npos && data.find("<?xml") < 16);

@@ -512,7 +512,15 @@ void keep(DecodedMessage& d, MissionLog& log) {
 }  // namespace
 
 MissionLog read_mission_log(const std::string& path, const BagTopics& bag_topics) {
-  McapFile f = read_mcap(path);
+  return mission_log_of(read_mcap(path), path, bag_topics);
+}
+
+MissionLog parse_mission_log(const std::string& bytes, const std::string& source,
+                             const BagTopics& bag_topics) {
+  return mission_log_of(read_mcap_bytes(bytes, source), source, bag_topics);
+}
+
+MissionLog mission_log_of(const McapFile& f, const std::string& path, const BagTopics& bag_topics) {
   MissionLog log;
   log.report = f.report;
   if (const auto* a = f.attachment("robot.json")) log.robot_json = a->data;

@@ -96,6 +96,7 @@ struct Recorder : RuntimeObserver {
         (!e.hypotheses.empty() && last->hypotheses.front().weight != e.hypotheses.front().weight);
     if (changed) r->hypotheses.push_back({e.stamp, e.mode, e.hypotheses});
   }
+  void on_input_fault(const InputFault& f) override { r->input_faults.push_back(f); }
   void on_ceiling(const FrameInput& f, const fusion::CeilingObservation& ob) override {
     LampFrame lf;
     lf.arrival = f.arrival;
@@ -140,6 +141,35 @@ std::string never_localized(const ReplayResult& r, const io::MissionLog& log) {
   else if (r.outcome.omni_frames == 0)
     s += ": no omni frame to find it with";
   return s;
+}
+
+std::string one_decimal(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f", v);
+  return buf;
+}
+
+// What came in wrong, in a few lines: each stream's faults counted, the first few in full, and
+// what the localizer did not use because of them.
+void note_input_faults(ReplayResult& r, const fusion::LocalizerCounts& c) {
+  constexpr std::size_t kShown = 3;
+  for (int s = 0; s < 3; ++s) {
+    const InputFaultCounts& n = r.outcome.faults[s];
+    r.metrics.input_faults[s] = n;
+    if (n.total() == 0) continue;
+    std::string line = std::string(to_string(static_cast<InputStream>(s))) + ": " +
+                       std::to_string(n.gaps) + " gaps (longest " + one_decimal(n.longest_gap_s) +
+                       " s), " + std::to_string(n.duplicates) + " duplicates, " +
+                       std::to_string(n.out_of_order) + " out of order";
+    std::size_t shown = 0;
+    for (const auto& f : r.input_faults)
+      if (static_cast<int>(f.stream) == s && shown++ < kShown) line += "; " + f.text();
+    r.notes.push_back(line);
+  }
+  r.metrics.frames_too_old = c.frames_too_old;
+  if (c.frames_too_old > 0)
+    r.notes.push_back(std::to_string(c.frames_too_old) +
+                      " frames captured before the filter's history (too late to apply)");
 }
 
 void score(ReplayResult& r, const io::MissionLog& log) {
@@ -265,6 +295,7 @@ ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
   r.metrics.runtime_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (const auto& p : robot_in.problems()) r.notes.push_back("skipped " + p);
+  note_input_faults(r, rt.localizer().counts());
   const auto& ev = rt.localizer().events();
   for (const auto& e : ev)
     if (e.reason != "initialized") r.events.push_back(e);
@@ -374,6 +405,18 @@ std::string metrics_json(const Metrics& m) {
           : Json(nullptr);
   j["lamps_seen"] = m.lamps_seen;
   j["lamps_labelled"] = m.lamps_labelled;
+  Json faults;
+  for (int s = 0; s < 3; ++s) {
+    const InputFaultCounts& f = m.input_faults[s];
+    faults[s == 0   ? "wheels"
+           : s == 1 ? "ceiling"
+                    : "omni"] = {{"gaps", f.gaps},
+                                 {"longest_gap_s", f.longest_gap_s},
+                                 {"duplicates", f.duplicates},
+                                 {"out_of_order", f.out_of_order}};
+  }
+  j["input_faults"] = faults;
+  j["frames_too_old"] = m.frames_too_old;
   j["runtime_s"] = m.runtime_s;
   j["realtime_factor"] = m.realtime_factor;
   return j.dump(2) + "\n";

@@ -9,6 +9,7 @@ namespace lampnav::navigation {
 void RuntimeOptions::validate() const {
   localizer.validate();
   executor.validate();
+  inputs.validate();
   if (!(max_duration_s > 0))
     throw InputError({"", "runtime options", "max_duration_s"}, "must be positive");
   if (!(start_sigma_m > 0) || !(start_sigma_deg > 0))
@@ -21,7 +22,8 @@ Runtime::Runtime(const graph::TopologicalMap& map, const RobotDescription& robot
       o_(options),
       localizer_(map, robot, options.localizer),
       executor_(map, robot.semi_axis, options.executor),
-      semi_axis_(robot.semi_axis) {
+      semi_axis_(robot.semi_axis),
+      inputs_(options.inputs) {
   o_.validate();
 }
 
@@ -35,6 +37,7 @@ RunOutcome Runtime::run(Robot& robot, const std::optional<Pose2>& start,
   bool driving = !mission.empty();  // a mission to start or in progress
   auto stop = [&] { robot.set_wheel_speeds(0, 0); };
   while (auto input = robot.next()) {
+    for (const InputFault& f : inputs_.check(*input)) obs.on_input_fault(f);
     if (const auto* w = std::get_if<WheelInput>(&*input)) {
       if (!out.first) {
         out.first = w->stamp;
@@ -104,6 +107,7 @@ RunOutcome Runtime::run(Robot& robot, const std::optional<Pose2>& start,
     }
   }
   stop();
+  for (int s = 0; s < 3; ++s) out.faults[s] = inputs_.counts(static_cast<InputStream>(s));
   out.status = executor_.status();
   if (!mission.empty() && out.status != ExecutorStatus::arrived && out.reason.empty())
     out.reason = out.time_limit ? "the time limit came first" : "the robot stopped giving input";

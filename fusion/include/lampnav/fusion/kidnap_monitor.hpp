@@ -90,7 +90,7 @@ class OmniCheck {
   std::vector<const graph::Lamp*> lamps_;
   // The smallest a lamp's blob can be, per unit of cos(theta): half the smallest lamp size seen
   // from the highest lamp's height above the camera. A smaller blob is a spurious light.
-  double min_blob_per_cos_ = 0;
+  double min_blob_per_cos_ = 0;  // spurious_blobs.hpp
 };
 
 class KidnapMonitor {

@@ -60,6 +60,10 @@ struct LocalizerOptions {
   // While tracking, a consistent omni frame refines the estimate's pose on the lamps it matched
   // and is applied as a measurement (at least this many lamps; 0 turns it off).
   int omni_update_min_lamps = 4;
+  // Wheel readings further apart than this (odometry that stopped and came back, a clock that
+  // jumped) leave the motion in between unknown: the estimate is no longer certain, and the
+  // localizer looks for the robot again (keeping the estimate as one of the places it may be).
+  Duration max_odometry_gap = std::chrono::seconds(2);
   void validate() const;
 };
 
@@ -108,6 +112,7 @@ struct LocalizerCounts {
   std::uint64_t relocalization_frames = 0;  // omni frames given to the global localizer
   std::uint64_t ambiguous_frames = 0;       // of those, leaving several hypotheses
   std::uint64_t omni_updates = 0;           // omni pose measurements applied while tracking
+  std::uint64_t odometry_gaps = 0;          // wheel readings further apart than max_odometry_gap
 };
 
 // Where relocalization stands: the hypotheses and why they do not settle it yet.

@@ -27,5 +27,7 @@ struct ImportedCamera {
 
 // Reads one calibration file (its format told by its keys).
 std::vector<ImportedCamera> read_calibration(const std::string& path);
+// The same from the file's text; `source` names it in messages.
+std::vector<ImportedCamera> parse_calibration(const std::string& text, const std::string& source);
 
 }  // namespace lampnav::io

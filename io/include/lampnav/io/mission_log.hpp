@@ -236,6 +236,11 @@ struct MissionLog {
 // MCAP at all, and for a bag whose topics cannot be told apart (the message lists them); damaged
 // content is skipped, counted and reported in the result.
 MissionLog read_mission_log(const std::string& path, const BagTopics& topics = {});
+// The same from the file's bytes (`source` names them in messages), and from a file read.
+MissionLog parse_mission_log(const std::string& bytes, const std::string& source,
+                             const BagTopics& topics = {});
+MissionLog mission_log_of(const McapFile& file, const std::string& source,
+                          const BagTopics& topics = {});
 
 // A bag's odometry as the wheel travel lampnav reads (conventions.md): each step of the odometry
 // pose, split between the two wheels of a differential drive with this semi-axis (m). Nothing is

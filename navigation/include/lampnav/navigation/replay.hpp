@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
-#include "lampnav/io/mission_log.hpp"
 #include "lampnav/core/robot.hpp"
+#include "lampnav/io/mission_log.hpp"
 #include "lampnav/navigation/runtime.hpp"
 
 namespace lampnav::navigation {
@@ -95,6 +95,8 @@ struct Metrics {
   int kidnaps = 0, recoveries = 0;
   ErrorStats relocalization_latency_s;  // from each kidnap to the fix that follows it
   std::size_t lamps_seen = 0, lamps_labelled = 0;
+  InputFaultCounts input_faults[3];  // by InputStream: gaps, duplicates, out of order
+  std::uint64_t frames_too_old = 0;  // captured before the filter's history
   double runtime_s = 0, realtime_factor = 0;
 };
 
@@ -104,6 +106,7 @@ struct ReplayResult {
   std::vector<std::pair<Stamp, Pose2>> odometry;  // wheels alone, from the first pose
   std::vector<LampFrame> lamp_frames;             // ceiling frames with their detections
   std::vector<fusion::LocalizerEvent> events;     // the localizer's mode changes
+  std::vector<InputFault> input_faults;           // as they came
   RunOutcome outcome;
   Metrics metrics;
   std::vector<std::string> notes;  // what was used, what was missing, what was cut short

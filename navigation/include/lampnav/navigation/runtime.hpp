@@ -8,18 +8,20 @@
 #include <string>
 #include <vector>
 
+#include "lampnav/core/robot.hpp"
 #include "lampnav/core/robot_description.hpp"
 #include "lampnav/fusion/localizer.hpp"
 #include "lampnav/graph/map.hpp"
 #include "lampnav/graph/route_commands.hpp"
 #include "lampnav/navigation/executor.hpp"
-#include "lampnav/core/robot.hpp"
+#include "lampnav/navigation/input_faults.hpp"
 
 namespace lampnav::navigation {
 
 struct RuntimeOptions {
   fusion::LocalizerOptions localizer;
   ExecutorOptions executor;
+  InputFaultOptions inputs;
   double max_duration_s = 3600;  // the loop stops after this much robot time
   // The starting pose's uncertainty when the robot is told where it starts.
   double start_sigma_m = 0.05, start_sigma_deg = 2.0;
@@ -36,6 +38,8 @@ class RuntimeObserver {
   virtual void on_omni(const FrameInput& /*frame*/, const vision::OmniDetection& /*detection*/) {}
   // A frame that is not an image of its camera (size, depth), with why.
   virtual void on_refused(const FrameInput& /*frame*/, const std::string& /*why*/) {}
+  // A fault in an input stream (input_faults.hpp), as it arrives.
+  virtual void on_input_fault(const InputFault& /*fault*/) {}
   // Route commands given while running: taken (why empty) or refused, with why.
   virtual void on_command(const CommandInput& /*command*/, const std::string& /*why*/) {}
 };
@@ -45,8 +49,9 @@ struct RunOutcome {
   std::string reason;                            // why the mission failed
   std::size_t wheel_readings = 0, ceiling_frames = 0, omni_frames = 0, refused_frames = 0;
   std::size_t commands = 0, refused_commands = 0;  // given while running
-  std::optional<Stamp> first, last;  // robot time span
-  bool time_limit = false;           // stopped by max_duration_s
+  InputFaultCounts faults[3];                      // by InputStream
+  std::optional<Stamp> first, last;                // robot time span
+  bool time_limit = false;                         // stopped by max_duration_s
   double duration_s() const { return first && last ? to_seconds(*last - *first) : 0.0; }
 };
 
@@ -74,6 +79,7 @@ class Runtime {
   fusion::Localizer localizer_;
   Executor executor_;
   double semi_axis_;
+  InputFaultMonitor inputs_;
 };
 
 }  // namespace lampnav::navigation
