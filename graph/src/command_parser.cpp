@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <optional>
 
 #include "lampnav/graph/route_commands.hpp"
@@ -253,6 +254,16 @@ class Parser {
 
   void tokenize() {
     const std::string& s = text_;
+    // Control characters (NUL, escape, ...) are no part of a command: refused, not read around.
+    for (std::size_t k = 0; k < s.size(); ++k) {
+      const auto c = static_cast<unsigned char>(s[k]);
+      if ((c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7F) {
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "0x%02X", c);
+        throw CommandParseError(source_, text_, k + 1, hex,
+                                std::string("control character ") + hex + " in the text");
+      }
+    }
     std::size_t i = 0;
     while (i < s.size()) {
       const char ch = s[i];
@@ -272,6 +283,9 @@ class Parser {
         }
         const std::string q = s.substr(i + 1, close - i - 1);
         if (q.empty()) throw CommandParseError(source_, text_, col, "\"\"", "empty quoted name");
+        if (q.find_first_of("\t\n\r") != std::string::npos)
+          throw CommandParseError(source_, text_, col, "\"" + q + "\"",
+                                  "a tab or line break inside a quoted name");
         toks_.push_back({Tok::quoted, q, lower(q), col});
         i = close + 1;
       } else {

@@ -113,5 +113,20 @@ TEST(CheckCommands, NamesMustExistWithTheRightPlace) {
   EXPECT_THROW(check_commands(s.map(), parse_route_commands("stop at door Lab 9")), InputError);
 }
 
+// Found by the route-command fuzzer: a quoted name holding a tab and a NUL was taken, and written
+// back it read as another command. Control characters are refused, naming where.
+TEST(CommandParser, ControlCharactersAreRefusedWhereTheyAre) {
+  try {
+    parse_route_commands(std::string("stop at door \"La\t\0b 6\"", 23));
+    FAIL() << "a NUL was read";
+  } catch (const CommandParseError& e) {
+    EXPECT_EQ(e.column(), 18u);
+    EXPECT_THAT(e.what(), ::testing::HasSubstr("control character 0x00"));
+  }
+  EXPECT_THROW(parse_route_commands("stop at door \"Lab\t3\""), CommandParseError);
+  EXPECT_THROW(parse_route_commands("go to J2\x1b[2J"), CommandParseError);
+  EXPECT_NO_THROW(parse_route_commands("go to J2\r\nstop at end E1\t"));
+}
+
 }  // namespace
 }  // namespace lampnav::graph
