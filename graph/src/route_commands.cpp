@@ -17,7 +17,11 @@ const char* const kOrdinals[] = {"first", "second",  "third",  "fourth", "fifth"
                                  "sixth", "seventh", "eighth", "ninth",  "tenth"};
 
 bool needs_quotes(const std::string& name) {
-  if (name.find_first_of(",;()\"\n") != std::string::npos) return true;
+  if (name.find_first_of(",;()\"\n\t\r") != std::string::npos) return true;
+  // Unquoted, a name is words one space apart.
+  if (name.empty() || name.front() == ' ' || name.back() == ' ' ||
+      name.find("  ") != std::string::npos)
+    return true;
   if (name.find(". ") != std::string::npos || (!name.empty() && name.back() == '.')) return true;
   std::string padded = " " + name + " ";
   for (auto& ch : padded) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
