@@ -209,6 +209,10 @@ std::vector<ImportedCamera> parse_calibration(const std::string& data, const std
       root = from_opencv(fs.root());
     } catch (const cv::Exception& e) {
       throw InputError({path, "", ""}, "not a YAML or XML calibration file: " + e.err);
+    } catch (const std::exception& e) {
+      // OpenCV's parser lets through what its own allocations throw on a malformed file.
+      throw InputError({path, "", ""},
+                       std::string("not a YAML or XML calibration file (") + e.what() + ")");
     }
   } else {
     try {

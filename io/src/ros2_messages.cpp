@@ -127,8 +127,11 @@ OdometryPose odometry(const std::string& data) {
                qz = r.f64("pose.pose.orientation.z"), qw = r.f64("pose.pose.orientation.w");
   for (int k = 0; k < 36; ++k) r.f64("pose.covariance");
   for (int k = 0; k < 6 + 36; ++k) r.f64("twist");
-  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(qx + qy + qz + qw))
+  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(qx) || !std::isfinite(qy) ||
+      !std::isfinite(qz) || !std::isfinite(qw))
     throw CdrError("pose is not finite");
+  if (std::abs(std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw) - 1) > 0.01)
+    throw CdrError("pose.pose.orientation is not a unit quaternion");
   const double yaw = std::atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz));
   o.pose = Pose2(x, y, yaw);
   return o;

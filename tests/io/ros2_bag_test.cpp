@@ -454,5 +454,27 @@ TEST(Ros2Bag, CameraMountsFromTheBagsTransforms) {
   EXPECT_TRUE(m2->xyz.isApprox(Eigen::Vector3d(0.2, 0.1, 1.5), 1e-12));
 }
 
+// Images are PNG or JPEG, told by their bytes (OpenCV's other decoders, JPEG 2000 among them, are
+// never reached), and a header that asks for gigapixels is refused before anything is allocated.
+TEST(Images, OnlyPngAndJpegOfASizeLampnavReads) {
+  const Image8 g = gradient(9, 7);
+  EXPECT_EQ(decode_image(encode_png(g), "a.png").pixels, g.pixels);
+  EXPECT_EQ(decode_image(encode_jpeg(g, 90), "a.jpg").width, 9);
+  try {
+    decode_image(std::string("\x00\x00\x00\x0cjP  \r\n\x87\n", 12), "a.jp2");
+    ADD_FAILURE() << "JPEG 2000 decoded";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("not a PNG or JPEG image"));
+  }
+  std::string bomb = encode_png(g);
+  for (int k = 16; k < 24; ++k) bomb[k] = k % 4 == 1 ? '\x01' : '\x00';  // 65536 x 65536
+  try {
+    decode_image(bomb, "bomb.png");
+    ADD_FAILURE() << "a 4-gigapixel header was decoded";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("65536 x 65536 pixels"));
+  }
+}
+
 }  // namespace
 }  // namespace lampnav::io
