@@ -86,20 +86,24 @@ std::string base64_decode(const std::string& text) {
   return out;
 }
 
-std::string encode_png(const Image8& image, int compression) {
+namespace {
+
+std::string encode(const Image8& image, const char* ext, int parameter, int value) {
   const cv::Mat m(image.height, image.width, CV_8UC1,
                   const_cast<std::uint8_t*>(image.pixels.data()));
   std::vector<uchar> buf;
-  cv::imencode(".png", m, buf, {cv::IMWRITE_PNG_COMPRESSION, compression});
+  cv::imencode(ext, m, buf, {parameter, value});
   return std::string(buf.begin(), buf.end());
 }
 
+}  // namespace
+
+std::string encode_png(const Image8& image, int compression) {
+  return encode(image, ".png", cv::IMWRITE_PNG_COMPRESSION, compression);
+}
+
 std::string encode_jpeg(const Image8& image, int quality) {
-  const cv::Mat m(image.height, image.width, CV_8UC1,
-                  const_cast<std::uint8_t*>(image.pixels.data()));
-  std::vector<uchar> buf;
-  cv::imencode(".jpg", m, buf, {cv::IMWRITE_JPEG_QUALITY, quality});
-  return std::string(buf.begin(), buf.end());
+  return encode(image, ".jpg", cv::IMWRITE_JPEG_QUALITY, quality);
 }
 
 namespace {

@@ -8,23 +8,8 @@
 // (stamps as { "sec", "nanosec" }; uint8[] data as hex in "data_hex"). Prints one line per case
 // and exits 1 on the first difference.
 import { MessageWriter } from "@foxglove/rosmsg2-serialization";
-import { ros2humble } from "@foxglove/rosmsg-msgs-common";
+import { definitions } from "./ros2_definitions.mjs";
 import { readFileSync } from "node:fs";
-
-function definitions(type) {
-  const out = [];
-  const seen = new Set();
-  const visit = (name) => {
-    if (seen.has(name)) return;
-    seen.add(name);
-    const def = ros2humble[name];
-    if (!def) throw new Error(`no definition of ${name}`);
-    out.push(def);
-    for (const f of def.definitions) if (f.isComplex) visit(f.type);
-  };
-  visit(type);
-  return out;
-}
 
 // "pkg/msg/Name" is "pkg/Name" in the definitions package.
 const key = (type) => type.replace("/msg/", "/");

@@ -11,7 +11,7 @@
 // capture times, log times the arrival times.
 import { McapWriter } from "@mcap/core";
 import { MessageWriter } from "@foxglove/rosmsg2-serialization";
-import { ros2humble } from "@foxglove/rosmsg-msgs-common";
+import { definitions } from "./ros2_definitions.mjs";
 import { open } from "node:fs/promises";
 import { openMcap } from "./open_mcap.mjs";
 
@@ -20,22 +20,6 @@ const semiAxis = Number(semiAxisText);
 if (!input || !output || !(semiAxis > 0)) {
   console.error("usage: node write_ros2_bag.mjs MISSION.mcap BAG.mcap SEMI_AXIS");
   process.exit(2);
-}
-
-// A type's definition with every type it uses, the root first (what MessageWriter takes).
-function definitions(type) {
-  const out = [];
-  const seen = new Set();
-  const visit = (name) => {
-    if (seen.has(name)) return;
-    seen.add(name);
-    const def = ros2humble[name];
-    if (!def) throw new Error(`no definition of ${name}`);
-    out.push(def);
-    for (const f of def.definitions) if (f.isComplex) visit(f.type);
-  };
-  visit(type);
-  return out;
 }
 
 // The .msg text rosbag2 stores as the schema: the root's fields, then each dependency after a
