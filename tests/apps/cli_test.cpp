@@ -197,7 +197,7 @@ TEST(Cli, LocateSaysWhyWhenThereIsNoPoseOrTheInputIsBad) {
   EXPECT_THAT(wrong.err, HasSubstr("640"));
   const Result garbage = run(locate_args("'" + text + "'"));
   EXPECT_EQ(garbage.status, 2);
-  EXPECT_THAT(garbage.err, HasSubstr("does not decode"));
+  EXPECT_THAT(garbage.err, HasSubstr("not a PNG or JPEG image"));
   const Result missing = run(locate_args("/nonexistent.png"));
   EXPECT_EQ(missing.status, 2);
   EXPECT_THAT(missing.err, HasSubstr("/nonexistent.png"));
