@@ -155,7 +155,10 @@ TEST(MapBuild, ReplayOnTheBuiltMapIsAsGoodAsOnTheTrueMap) {
       graph::read_map(test::source_path("maps/office_floor.geojson")).map;
   const Pose2 start = io::read_mission_log(drive).truth.front().value.pose;
   std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> pairs;
-  for (const auto& n : graph::read_map(built).map.nodes()) {
+  // (The map kept in a variable: a range over a temporary's nodes outlives the map. Found by
+  // AddressSanitizer.)
+  const graph::TopologicalMap built_map = graph::read_map(built).map;
+  for (const auto& n : built_map.nodes()) {
     for (const auto& l : n.lamps) {
       const auto near = truth.lamps_within(start.transform_from(l.xyz.head<2>()), 0.3);
       if (!near.empty()) pairs.emplace_back(l.xyz.head<2>(), near.front()->xyz.head<2>());
