@@ -41,7 +41,7 @@ struct Publisher : navigation::RuntimeObserver {
 
   void on_estimate(const fusion::LocalizerEstimate& e) override {
     robot->publish(e);
-    mission_news(e.stamp);
+    mission_news();
   }
   void after_frame(CameraRole camera) {
     const fusion::Localizer& l = runtime->localizer();
@@ -72,7 +72,7 @@ struct Publisher : navigation::RuntimeObserver {
     last_mission.clear();
   }
   // The mission's end, once.
-  void mission_news(Stamp) {
+  void mission_news() {
     const navigation::Executor& x = runtime->executor();
     std::string news;
     if (x.status() == navigation::ExecutorStatus::arrived) news = "arrived";

@@ -594,6 +594,24 @@ MissionLog mission_log_of(const McapFile& f, const std::string& path, const BagT
   return log;
 }
 
+std::vector<LogInput> inputs_in_arrival_order(const MissionLog& log, bool ceiling, bool omni) {
+  using Kind = LogInput::Kind;
+  std::vector<LogInput> items;
+  for (std::size_t i = 0; i < log.wheels.size(); ++i)
+    items.push_back({log.wheels[i].log_time, Kind::wheels, i});
+  if (ceiling)
+    for (std::size_t i = 0; i < log.ceiling_images.size(); ++i)
+      items.push_back({log.ceiling_images[i].log_time, Kind::ceiling, i});
+  if (omni)
+    for (std::size_t i = 0; i < log.omni_images.size(); ++i)
+      items.push_back({log.omni_images[i].log_time, Kind::omni, i});
+  std::stable_sort(items.begin(), items.end(), [](const LogInput& a, const LogInput& b) {
+    return a.arrival != b.arrival ? a.arrival < b.arrival
+                                  : a.kind == Kind::wheels && b.kind != Kind::wheels;
+  });
+  return items;
+}
+
 TruthTrack::TruthTrack(std::vector<Logged<TruthPose>> truth) : truth_(std::move(truth)) {
   std::stable_sort(truth_.begin(), truth_.end(),
                    [](const auto& a, const auto& b) { return a.value.stamp < b.value.stamp; });

@@ -59,7 +59,7 @@ InputFaultMonitor::InputFaultMonitor(const InputFaultOptions& options) : o_(opti
   o_.validate();
 }
 
-std::vector<InputFault> InputFaultMonitor::check(const RobotInput& input) {
+std::optional<InputFault> InputFaultMonitor::check(const RobotInput& input) {
   InputStream s;
   Stamp t;
   if (const auto* w = std::get_if<WheelInput>(&input)) {
@@ -69,24 +69,24 @@ std::vector<InputFault> InputFaultMonitor::check(const RobotInput& input) {
     s = f->camera == CameraRole::ceiling ? InputStream::ceiling : InputStream::omni;
     t = f->capture;
   } else {
-    return {};
+    return std::nullopt;
   }
   const int i = static_cast<int>(s);
-  std::vector<InputFault> out;
+  std::optional<InputFault> out;
   if (seen_[i]) {
     const double dt = to_seconds(t - last_[i]);
     const double limit = s == InputStream::wheels ? o_.wheels_gap_s : o_.camera_gap_s;
     InputFaultCounts& c = counts_[i];
     if (dt == 0) {
       ++c.duplicates;
-      out.push_back({s, InputFaultKind::duplicate, t, 0});
+      out = InputFault{s, InputFaultKind::duplicate, t, 0};
     } else if (dt < 0) {
       ++c.out_of_order;
-      out.push_back({s, InputFaultKind::out_of_order, t, -dt});
+      out = InputFault{s, InputFaultKind::out_of_order, t, -dt};
     } else if (dt > limit) {
       ++c.gaps;
       c.longest_gap_s = std::max(c.longest_gap_s, dt);
-      out.push_back({s, InputFaultKind::gap, t, dt});
+      out = InputFault{s, InputFaultKind::gap, t, dt};
     }
   }
   // The stream's clock is the latest stamp seen: a message back in time does not move it back.

@@ -24,27 +24,16 @@ constexpr double kDeg = M_PI / 180.0;
 // ---------------------------------------------------------------------------------------------
 // The recorded robot.
 
-LogRobot::LogRobot(const io::MissionLog& log, bool use_ceiling, bool use_omni) : log_(&log) {
-  for (std::size_t i = 0; i < log.wheels.size(); ++i)
-    items_.push_back({log.wheels[i].log_time, 0, i});
-  if (use_ceiling)
-    for (std::size_t i = 0; i < log.ceiling_images.size(); ++i)
-      items_.push_back({log.ceiling_images[i].log_time, 1, i});
-  if (use_omni)
-    for (std::size_t i = 0; i < log.omni_images.size(); ++i)
-      items_.push_back({log.omni_images[i].log_time, 2, i});
-  // Arrival order; at the same instant the wheel reading first, as the robot delivered them.
-  std::stable_sort(items_.begin(), items_.end(), [](const Item& a, const Item& b) {
-    return a.arrival != b.arrival ? a.arrival < b.arrival : a.kind == 0 && b.kind != 0;
-  });
-}
+LogRobot::LogRobot(const io::MissionLog& log, bool use_ceiling, bool use_omni)
+    : log_(&log), items_(io::inputs_in_arrival_order(log, use_ceiling, use_omni)) {}
 
 LogRobot::Decoded LogRobot::decode(const Item& it) const {
-  const auto& f = (it.kind == 1 ? log_->ceiling_images : log_->omni_images)[it.index];
+  const bool ceiling = it.kind == io::LogInput::Kind::ceiling;
+  const auto& f = (ceiling ? log_->ceiling_images : log_->omni_images)[it.index];
   try {
     return {io::decode_image(f.value.data, f.value.frame_id), {}};
   } catch (const InputError& e) {
-    return {std::nullopt, std::string(it.kind == 1 ? "ceiling" : "omni") + " frame captured at " +
+    return {std::nullopt, std::string(ceiling ? "ceiling" : "omni") + " frame captured at " +
                               std::to_string(to_seconds(f.value.stamp)) + " s: " + e.message()};
   }
 }
@@ -55,13 +44,13 @@ std::optional<RobotInput> LogRobot::next() {
     // Keep up to kAhead frames decoding ahead of the loop.
     while (ahead_.size() < kAhead && launched_ < items_.size()) {
       const std::size_t k = launched_++;
-      if (items_[k].kind == 0) continue;
+      if (items_[k].kind == io::LogInput::Kind::wheels) continue;
       ahead_.emplace_back(k,
                           std::async(std::launch::async, [this, k] { return decode(items_[k]); }));
     }
     const std::size_t k = next_++;
     const Item& it = items_[k];
-    if (it.kind == 0) {
+    if (it.kind == io::LogInput::Kind::wheels) {
       const auto& w = log_->wheels[it.index];
       return WheelInput{w.value.stamp, w.value.left, w.value.right};
     }
@@ -71,9 +60,10 @@ std::optional<RobotInput> LogRobot::next() {
       problems_.push_back(d.problem);
       continue;
     }
-    const auto& f = (it.kind == 1 ? log_->ceiling_images : log_->omni_images)[it.index];
-    return FrameInput{it.kind == 1 ? CameraRole::ceiling : CameraRole::omni, f.value.stamp,
-                      f.log_time, std::move(*d.image)};
+    const bool ceiling = it.kind == io::LogInput::Kind::ceiling;
+    const auto& f = (ceiling ? log_->ceiling_images : log_->omni_images)[it.index];
+    return FrameInput{ceiling ? CameraRole::ceiling : CameraRole::omni, f.value.stamp, f.log_time,
+                      std::move(*d.image)};
   }
   return std::nullopt;
 }

@@ -37,7 +37,7 @@ RunOutcome Runtime::run(Robot& robot, const std::optional<Pose2>& start,
   bool driving = !mission.empty();  // a mission to start or in progress
   auto stop = [&] { robot.set_wheel_speeds(0, 0); };
   while (auto input = robot.next()) {
-    for (const InputFault& f : inputs_.check(*input)) obs.on_input_fault(f);
+    if (const auto fault = inputs_.check(*input)) obs.on_input_fault(*fault);
     if (const auto* w = std::get_if<WheelInput>(&*input)) {
       if (!out.first) {
         out.first = w->stamp;

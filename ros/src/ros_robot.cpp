@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "lampnav/core/error.hpp"
+#include "lampnav/fusion/ekf.hpp"
 #include "lampnav/io/mission_log.hpp"
 
 namespace lampnav::ros {
@@ -206,13 +207,13 @@ std::optional<RobotInput> RosRobot::decode(Pending& p) {
           io::ros2::wheel_joints(cdr, o_.topics.left_joint, o_.topics.right_joint);
       const auto w = joint_wheels_.add(j);
       if (!w) return std::nullopt;
-      // The odometry frame: the wheels integrated (exact arcs).
+      // The odometry frame: the wheels integrated by the conventions' motion model.
       Pose2 pose = odom_.empty() ? Pose2() : odom_.back().second;
       if (last_wheels_) {
-        const double dl = w->left - last_wheels_->left, dr = w->right - last_wheels_->right;
-        const double ds = (dl + dr) / 2, dyaw = (dr - dl) / (2 * o_.semi_axis);
-        const double chord = std::abs(dyaw) < 1e-9 ? ds : 2 * ds / dyaw * std::sin(dyaw / 2);
-        pose = pose * Pose2(chord * std::cos(dyaw / 2), chord * std::sin(dyaw / 2), dyaw);
+        const fusion::StateVector x =
+            fusion::predict_motion(pose.vector(), w->left - last_wheels_->left,
+                                   w->right - last_wheels_->right, o_.semi_axis);
+        pose = Pose2(x.x(), x.y(), wrap_angle(x.z()));
       }
       last_wheels_ = WheelInput{w->stamp, w->left, w->right};
       odom_.emplace_back(w->stamp, pose);

@@ -80,9 +80,9 @@ void route_commands(const std::uint8_t* data, std::size_t size) {
   const std::string in = text(data, size);
   contract([&] { return graph::parse_route_commands(in, "fuzz"); },
            [](const std::vector<graph::RouteCommand>& commands) {
+             if (commands.empty()) return;
              std::string again;
              for (const auto& c : commands) again += (again.empty() ? "" : ", ") + c.text();
-             if (commands.empty()) return;
              const auto reparsed = graph::parse_route_commands(again, "written");
              if (reparsed.size() != commands.size())
                broken("commands written and read again: " + again);

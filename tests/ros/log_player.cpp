@@ -7,7 +7,6 @@
 //                      [--wait-s S] [--loops N] [--jpeg QUALITY]
 // Prints one line of counts; exit 0, 1 when no node answered, 2 for bad arguments.
 
-#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -76,21 +75,7 @@ int main(int argc, char** argv) {
   }
   std::this_thread::sleep_for(std::chrono::milliseconds(200));
 
-  struct Item {
-    Stamp arrival;
-    int kind;  // 0 wheels, 1 ceiling, 2 omni
-    std::size_t index;
-  };
-  std::vector<Item> items;
-  for (std::size_t i = 0; i < log.wheels.size(); ++i)
-    items.push_back({log.wheels[i].log_time, 0, i});
-  for (std::size_t i = 0; i < log.ceiling_images.size(); ++i)
-    items.push_back({log.ceiling_images[i].log_time, 1, i});
-  for (std::size_t i = 0; i < log.omni_images.size(); ++i)
-    items.push_back({log.omni_images[i].log_time, 2, i});
-  std::stable_sort(items.begin(), items.end(), [](const Item& a, const Item& b) {
-    return a.arrival != b.arrival ? a.arrival < b.arrival : a.kind == 0 && b.kind != 0;
-  });
+  const std::vector<io::LogInput> items = io::inputs_in_arrival_order(log);
 
   long sent[3] = {0, 0, 0}, refused = 0;
   const Duration span = items.empty() ? Duration(0) : items.back().arrival - items.front().arrival;
@@ -99,25 +84,26 @@ int main(int argc, char** argv) {
     // Each loop shifts the log's times by its span (and 1 s), so stamps keep increasing.
     const Duration shift = (span + std::chrono::seconds(1)) * loop;
     const Stamp first = items.empty() ? Stamp{} : items.front().arrival;
-    for (const Item& it : items) {
+    for (const io::LogInput& it : items) {
       const double due_s = (to_seconds(it.arrival - first) + to_seconds(shift)) / o.rate;
       std::this_thread::sleep_until(
           t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(due_s)));
       bool ok = false;
-      if (it.kind == 0) {
+      const int kind = static_cast<int>(it.kind);  // 0 wheels, 1 ceiling, 2 omni
+      if (kind == 0) {
         const auto& w = log.wheels[it.index].value;
         ok = joints.write(io::ros2::joint_state_message(
             w.stamp + shift, {"left_wheel_joint", "right_wheel_joint"},
             {w.left / o.wheel_radius, w.right / o.wheel_radius}));
       } else {
-        const auto& f = (it.kind == 1 ? log.ceiling_images : log.omni_images)[it.index].value;
-        ok = (it.kind == 1 ? ceiling : omni)
+        const auto& f = (kind == 1 ? log.ceiling_images : log.omni_images)[it.index].value;
+        ok = (kind == 1 ? ceiling : omni)
                  .write(io::ros2::compressed_image_message(
-                     f.stamp + shift, it.kind == 1 ? "ceiling_camera" : "omni_camera", f.format,
+                     f.stamp + shift, kind == 1 ? "ceiling_camera" : "omni_camera", f.format,
                      f.data));
       }
       if (ok)
-        ++sent[it.kind];
+        ++sent[kind];
       else
         ++refused;
     }

@@ -3,6 +3,7 @@
 // is taken, wheel speeds out as a Twist, an estimate out as the pose and map -> odom.
 
 #include <mutex>
+#include <thread>
 
 #include "cdr.hpp"
 #include "lampnav/io/ros2_messages.hpp"
@@ -84,7 +85,7 @@ TEST(RosRobot, TakesInputsRefusesDamagedOnesAndPublishes) {
   std::vector<FrameInput> frames;
   std::vector<CommandInput> commands;
   std::thread stopper([&] {
-    test::wait_for([&] { return false; }, 3);
+    std::this_thread::sleep_for(std::chrono::seconds(3));
     robot.stop();
   });
   while (auto in = robot.next()) {

@@ -217,7 +217,7 @@ struct MissionLog {
   std::vector<Logged<OdometryPose>> odometry;     // a ROS 2 bag's (see wheels_from_odometry)
   std::vector<Logged<WheelJoints>> wheel_joints;  // a ROS 2 bag's (see wheels_from_joints)
   std::map<std::string, CameraInfo> camera_info;  // by topic, the last of each
-  std::vector<FrameTransform> transforms;          // a ROS 2 bag's /tf_static and /tf, in order
+  std::vector<FrameTransform> transforms;         // a ROS 2 bag's /tf_static and /tf, in order
   std::vector<Logged<ImageFrame>> ceiling_images, omni_images;
   std::vector<Logged<TruthPose>> truth;
   std::vector<Logged<MissionEvent>> events;
@@ -241,6 +241,17 @@ MissionLog parse_mission_log(const std::string& bytes, const std::string& source
                              const BagTopics& topics = {});
 MissionLog mission_log_of(const McapFile& file, const std::string& source,
                           const BagTopics& topics = {});
+
+// A log's inputs in the order they became available (log time); at the same instant a wheel
+// reading first, as the robot delivered them. `index` is into the log's vector of that kind.
+struct LogInput {
+  enum class Kind { wheels, ceiling, omni };
+  Stamp arrival;
+  Kind kind;
+  std::size_t index;
+};
+std::vector<LogInput> inputs_in_arrival_order(const MissionLog& log, bool ceiling = true,
+                                              bool omni = true);
 
 // A bag's odometry as the wheel travel lampnav reads (conventions.md): each step of the odometry
 // pose, split between the two wheels of a differential drive with this semi-axis (m). Nothing is

@@ -8,8 +8,8 @@
 // counted in LocalizerCounts); this says what came in.
 
 #include <cstdint>
+#include <optional>
 #include <string>
-#include <vector>
 
 #include "lampnav/core/robot.hpp"
 #include "lampnav/core/time.hpp"
@@ -45,8 +45,9 @@ struct InputFaultCounts {
 class InputFaultMonitor {
  public:
   explicit InputFaultMonitor(const InputFaultOptions& options = {});
-  // Looks at one input; a fault it shows is counted and returned. Commands are not stamped.
-  std::vector<InputFault> check(const RobotInput& input);
+  // Looks at one input; the fault it shows, if any, is counted and returned. Commands are not
+  // stamped.
+  std::optional<InputFault> check(const RobotInput& input);
   const InputFaultCounts& counts(InputStream s) const { return counts_[static_cast<int>(s)]; }
 
  private:

@@ -29,11 +29,7 @@ class LogRobot : public Robot {
   const std::vector<std::string>& problems() const { return problems_; }
 
  private:
-  struct Item {
-    Stamp arrival;
-    int kind;  // 0 wheels, 1 ceiling, 2 omni
-    std::size_t index;
-  };
+  using Item = io::LogInput;
   struct Decoded {
     std::optional<Image8> image;
     std::string problem;
