@@ -35,6 +35,13 @@ void LocalizerOptions::validate() const {
   global.validate();
   if (omni_update_min_lamps < 0)
     throw InputError({"", "localizer options", "omni_update_min_lamps"}, "must not be negative");
+  if (!(second_opinion_ratio == 0 ||
+        (second_opinion_ratio >= 1 && std::isfinite(second_opinion_ratio))))
+    throw InputError({"", "localizer options", "second_opinion_ratio"},
+                     "must be 0 (off) or a likelihood ratio of at least 1");
+  if (!(second_opinion_distance > 0 && std::isfinite(second_opinion_distance)))
+    throw InputError({"", "localizer options", "second_opinion_distance"},
+                     "must be a positive distance in m");
   if (!(max_odometry_gap > Duration::zero()))
     throw InputError({"", "localizer options", "max_odometry_gap"}, "must be positive");
   hypotheses.validate();
@@ -163,6 +170,31 @@ struct Localizer::Impl {
     ++counts.relocalization_frames;
     hypotheses->omni(stamp, last_omni, odometry);
     settle(stamp, self);
+  }
+
+  // An omni check disagreed with the estimate once: does the frame itself put the robot
+  // elsewhere, far more likely than where the estimate is? Both poses are scored alike (the
+  // estimate's uncertainty for both), so the ratio compares the places, not their refinement.
+  std::optional<std::string> second_opinion(const FilterState& prior, const OmniCheckResult& r) {
+    if (o.second_opinion_ratio <= 0) return std::nullopt;
+    const GlobalLocalization g = global->locate(last_omni);
+    if (!g.found() || g.ambiguous) return std::nullopt;
+    const Pose2& alt = g.hypotheses.front().pose;
+    const double away = (alt.translation() - prior.pose().translation()).norm();
+    if (away < o.second_opinion_distance) return std::nullopt;
+    const double sp = std::clamp(std::sqrt(std::max(prior.P(0, 0), prior.P(1, 1))), 0.05, 0.5);
+    const double sy = std::clamp(std::sqrt(prior.P(2, 2)), 0.5 * kDeg, 5 * kDeg);
+    const double here = global->score(prior.pose(), sp, sy, last_omni).cost;
+    const double there = global->score(alt, sp, sy, last_omni).cost;
+    const double log_ratio = 0.5 * (here - there);
+    if (log_ratio < std::log(o.second_opinion_ratio)) return std::nullopt;
+    ++counts.second_opinions;
+    char why[200];
+    std::snprintf(why, sizeof why,
+                  "the omnidirectional view does not match the estimate (%d of %d predicted lamps "
+                  "seen) and puts the robot %.1f m away, e^%.0f times likelier",
+                  r.matched, r.expected, away, log_ratio);
+    return std::string(why);
   }
 
   // While tracking: the omni frame's lamps, matched near the estimate, as a pose measurement.
@@ -399,7 +431,12 @@ void Localizer::omni_detection(Stamp stamp, const vision::OmniDetection& detecti
   if (m.mode == LocalizerMode::relocalized && r.conclusive && r.consistent)
     m.set_mode(LocalizerMode::tracking,
                "the omnidirectional view agrees with the relocalized pose");
-  m.lose(m.monitor.omni(r));
+  std::optional<std::string> loss = m.monitor.omni(r);
+  if (!loss && r.conclusive && !r.consistent) {
+    loss = m.second_opinion(*prior, r);
+    if (loss) m.monitor.reset();
+  }
+  m.lose(loss);
   if (m.unsure()) {
     m.relocalize(stamp, *this);  // the frame that showed the loss shows where the robot is
   } else if (r.conclusive && r.consistent && m.o.omni_update_min_lamps > 0) {

@@ -60,6 +60,12 @@ struct LocalizerOptions {
   // While tracking, a consistent omni frame refines the estimate's pose on the lamps it matched
   // and is applied as a measurement (at least this many lamps; 0 turns it off).
   int omni_update_min_lamps = 4;
+  // One omni check that disagrees with the estimate is not yet a loss (people hide lamps). It is
+  // when the same frame locates the robot elsewhere (farther than second_opinion_distance) with
+  // this likelihood ratio over the estimate, both scored alike: the frame then proves the jump
+  // and the robot is looked for at once (the estimate stays one of the places it may be). 0 off.
+  double second_opinion_ratio = 1000;
+  double second_opinion_distance = 1.0;  // m
   // Wheel readings further apart than this (odometry that stopped and came back, a clock that
   // jumped) leave the motion in between unknown: the estimate is no longer certain, and the
   // localizer looks for the robot again (keeping the estimate as one of the places it may be).
@@ -113,6 +119,7 @@ struct LocalizerCounts {
   std::uint64_t ambiguous_frames = 0;       // of those, leaving several hypotheses
   std::uint64_t omni_updates = 0;           // omni pose measurements applied while tracking
   std::uint64_t odometry_gaps = 0;          // wheel readings further apart than max_odometry_gap
+  std::uint64_t second_opinions = 0;  // losses an omni frame proved by locating the robot elsewhere
 };
 
 // Where relocalization stands: the hypotheses and why they do not settle it yet.
