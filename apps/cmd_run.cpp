@@ -86,6 +86,7 @@ void make_dir(const std::string& dir) {
 struct RunArgs {
   std::string map, mission = "office-mission", out = "lampnav-out";
   std::uint64_t seed = 1;
+  std::string image_format;
   bool quiet = false;
 };
 
@@ -115,7 +116,9 @@ int run_mission(const RunArgs& a) {
   const std::string map_text = json::read_file(map_path);
   const graph::LoadedMap loaded = graph::parse_map(map_text, map_path);
   const RobotDescription robot = read_robot_description(robot_path);
-  const sim::Scenario s = sim::make_named_scenario(a.mission, loaded.map, map_text, robot, a.seed);
+  sim::Scenario s = sim::make_named_scenario(a.mission, loaded.map, map_text, robot, a.seed);
+  if (!a.image_format.empty())
+    s.images = io::parse_image_encoding(a.image_format, "--image-format");
   make_dir(a.out);
   const std::string log_path = a.out + "/mission.mcap";
 
@@ -233,6 +236,8 @@ void add_run_commands(CLI::App& app, Job& run) {
   rc->add_option("--mission", ra->mission, "office-mission or corridor")->capture_default_str();
   rc->add_option("--out", ra->out, "Output directory")->capture_default_str();
   rc->add_option("--seed", ra->seed, "Random seed of the simulated world")->capture_default_str();
+  rc->add_option("--image-format", ra->image_format,
+                 "How the mission log stores frames: png, jpeg or jpeg:QUALITY (1-100)");
   rc->add_flag("-q,--quiet", ra->quiet, "No progress bar");
   rc->callback([ra, &run] { run = [ra] { return run_mission(*ra); }; });
 

@@ -27,6 +27,7 @@ struct SimArgs {
   bool no_bumps = false, quiet = false;
   double bump_deg = 0.5;
   std::optional<double> ceiling_delay, omni_delay;
+  std::string image_format;
 };
 
 int run_sim(const SimArgs& a) {
@@ -70,6 +71,8 @@ int run_sim(const SimArgs& a) {
   s.bump_sigma_rad = a.no_bumps ? 0.0 : a.bump_deg * M_PI / 180.0;
   if (a.ceiling_delay) s.ceiling_delay_s = *a.ceiling_delay;
   if (a.omni_delay) s.omni_delay_s = *a.omni_delay;
+  if (!a.image_format.empty())
+    s.images = io::parse_image_encoding(a.image_format, "--image-format");
 
   ProgressBar bar(a.quiet);
   const auto start = std::chrono::steady_clock::now();
@@ -120,6 +123,9 @@ void add_sim_command(CLI::App& app, Job& run) {
   cmd->add_option("--omni-delay", a->omni_delay,
                   "Omni camera capture-to-availability delay (s, default 0.5)")
       ->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--image-format", a->image_format,
+                  "How the log stores frames: png, jpeg or jpeg:QUALITY (1-100); default jpeg:" +
+                      std::to_string(io::ImageEncoding{}.jpeg_quality));
   cmd->add_flag("-q,--quiet", a->quiet, "No progress bar");
   cmd->add_option("-o,--output", a->out, "Mission log to write (.mcap)")->required();
   cmd->callback([a, &run] { run = [a] { return run_sim(*a); }; });

@@ -12,6 +12,7 @@
 #include <iterator>
 
 #include "lampnav/graph/geojson.hpp"
+#include "lampnav/io/image_encoding.hpp"
 #include "lampnav/navigation/replay.hpp"
 #include "lampnav/sim/building.hpp"
 #include "lampnav/sim/scenario.hpp"
@@ -27,7 +28,8 @@ struct RecordedMission {
   RobotDescription robot;
   Pose2 start;
   io::MissionLog log;
-  RecordedMission() {
+  std::uintmax_t bytes = 0;  // the log file's size
+  explicit RecordedMission(const io::ImageEncoding& images = {}) {
     const std::string src = LAMPNAV_SOURCE_DIR;
     const std::string text = [&] {
       std::ifstream in(src + "/maps/office_floor.geojson");
@@ -35,12 +37,14 @@ struct RecordedMission {
     }();
     map = graph::parse_map(text, "office_floor.geojson").map;
     robot = read_robot_description(src + "/maps/robots/pioneer.json");
-    const sim::Scenario s = sim::make_named_scenario("office-mission", map, text, robot, 1);
+    sim::Scenario s = sim::make_named_scenario("office-mission", map, text, robot, 1);
+    s.images = images;
     start = s.start;
     const std::string path = (std::filesystem::temp_directory_path() /
                               ("lampnav_bench_" + std::to_string(::getpid()) + ".mcap"))
                                  .string();
     sim::record_mission(s, path);
+    bytes = std::filesystem::file_size(path);
     log = io::read_mission_log(path);
     std::filesystem::remove(path);
   }
@@ -61,6 +65,71 @@ void BM_ReplayOfficeMission(benchmark::State& state) {
   state.counters["realtime_factor"] = factor;
 }
 BENCHMARK(BM_ReplayOfficeMission)->Unit(benchmark::kMillisecond)->Iterations(3)->UseRealTime();
+
+// The office mission's log with its frames stored as PNG (argument 0) or JPEG at the quality given:
+// the file's size, and the replay of it (the robot saw the frames as stored). The iteration time
+// is the replay's.
+void BM_OfficeMissionLog(benchmark::State& state) {
+  io::ImageEncoding e;
+  if (state.range(0) == 0) {
+    e.format = io::ImageEncoding::Format::png;
+  } else {
+    e.jpeg_quality = static_cast<int>(state.range(0));
+  }
+  const RecordedMission m(e);
+  navigation::ReplayOptions o;
+  o.initial_pose = m.start;
+  navigation::ReplayResult r;
+  for (auto _ : state) {
+    r = navigation::replay(m.log, m.map, m.robot, o);
+    benchmark::DoNotOptimize(r.estimates.data());
+  }
+  state.counters["log_MB"] = static_cast<double>(m.bytes) / 1e6;
+  state.counters["MB_per_s"] = static_cast<double>(m.bytes) / 1e6 / r.metrics.duration_s;
+  state.counters["mean_error_cm"] = 100 * r.metrics.position_error_m.mean;
+  state.counters["rms_error_cm"] = 100 * r.metrics.position_error_m.rms;
+  state.counters["realtime_factor"] = r.metrics.realtime_factor;
+}
+BENCHMARK(BM_OfficeMissionLog)
+    ->Arg(0)
+    ->Arg(95)
+    ->Arg(50)  // the default (io::ImageEncoding)
+    ->Arg(10)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(1)
+    ->UseRealTime();
+
+// Writing the office mission's inputs (JPEG frames at the default quality) to a log with zstd
+// chunks at the level given: how fast a robot can record, and what each level saves.
+void BM_WriteMissionLog(benchmark::State& state) {
+  static const RecordedMission m;
+  io::McapWriterOptions o;
+  o.zstd_level = static_cast<int>(state.range(0));
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("lampnav_bench_w" + std::to_string(::getpid()) + ".mcap"))
+                               .string();
+  std::uintmax_t bytes = 0, input = 0;
+  for (auto _ : state) {
+    {
+      io::MissionLogWriter w(path, o);
+      input = 0;
+      for (const auto& r : m.log.wheels) w.write(r.log_time, r.value);
+      for (const auto* images : {&m.log.ceiling_images, &m.log.omni_images})
+        for (const auto& f : *images) {
+          w.write_image(f.log_time, f.value);
+          input += f.value.data.size();
+        }
+      w.close();
+    }
+    bytes = std::filesystem::file_size(path);
+  }
+  std::filesystem::remove(path);
+  state.counters["log_MB"] = static_cast<double>(bytes) / 1e6;
+  state.counters["image_MB"] = static_cast<double>(input) / 1e6;
+  state.counters["write_MB_per_s"] =
+      benchmark::Counter(static_cast<double>(bytes) / 1e6, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_WriteMissionLog)->Arg(1)->Arg(3)->Arg(9)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 struct BuildingMission {
   graph::TopologicalMap map;

@@ -139,6 +139,45 @@ std::optional<double> counter(const std::string& bench, const std::string& name,
   return it->second.raw[name].get<double>() * to_us;
 }
 
+// A measured value (not a time) against a peer's, with an upper bound (a file's size), or, with
+// `tolerance`, a value that must stay within it of the peer's (an accuracy that must not change).
+void add_value(const std::string& what, std::optional<double> ours, const std::string& peer_label,
+               std::optional<double> peer, std::optional<double> max_value,
+               std::optional<double> tolerance, const std::string& unit) {
+  auto show_value = [&](double v) {
+    std::ostringstream s;
+    s << std::setprecision(3) << v << " " << unit;
+    return s.str();
+  };
+  Row r{what, ours ? show_value(*ours) : "not run", "", "", "", ""};
+  Json j{{"case", what}, {"ours", ours ? Json(*ours) : Json(nullptr)}, {"unit", unit}};
+  bool met = ours.has_value();
+  if (peer) {
+    r.peer = peer_label + ": " + show_value(*peer);
+    j["peer"] = peer_label;
+    j["peer_value"] = *peer;
+    if (ours && *ours > 0) {
+      std::ostringstream s;
+      s << std::setprecision(3) << *peer / *ours << "x";
+      r.ratio = s.str();
+    }
+  }
+  if (max_value) {
+    r.target = "<= " + show_value(*max_value);
+    j["target_max"] = *max_value;
+    met = met && *ours <= *max_value;
+  }
+  if (tolerance) {
+    r.target = "within " + show_value(*tolerance) + " of " + peer_label;
+    j["tolerance"] = *tolerance;
+    met = met && peer && std::fabs(*ours - *peer) <= *tolerance;
+  }
+  r.verdict = met ? "met" : "MISSED";
+  j["met"] = met;
+  rows.push_back(r);
+  out_rows.push_back(j);
+}
+
 // A count that must stay at or below `max_value` (messages lost).
 void add_count(const std::string& what, std::optional<double> v, double max_value) {
   Row r{what, v ? std::to_string(static_cast<long long>(*v)) : "not run", "",
@@ -278,7 +317,13 @@ int main(int argc, char** argv) {
         us(std::string("BM_BuildingWhichNode/") + n), "", std::nullopt, std::nullopt, std::nullopt);
   grows("which-node query", "BM_BuildingWhichNode");
   add_counter("replay of the office mission (140 s)", "BM_ReplayOfficeMission", "realtime_factor",
-              50, "x real time");
+              150, "x real time");
+  // The office mission's log: frames as JPEG at the default quality (argument 50) against PNG.
+  add_value("office mission log (140 s), JPEG 50", counter("BM_OfficeMissionLog/50", "log_MB", 1),
+            "PNG", counter("BM_OfficeMissionLog/0", "log_MB", 1), 20.0, std::nullopt, "MB");
+  add_value("office mission replay from the JPEG log, mean position error",
+            counter("BM_OfficeMissionLog/50", "mean_error_cm", 1), "PNG",
+            counter("BM_OfficeMissionLog/0", "mean_error_cm", 1), std::nullopt, 0.1, "cm");
   for (const char* n : {"10", "100", "1000"})
     add_counter(std::string("replay of a 10-minute mission, ") + n + "-node building",
                 std::string("BM_ReplayBuildingMission/") + n, "realtime_factor", 50, "x real time");

@@ -9,8 +9,6 @@
 #include <cstring>
 #include <map>
 #include <nlohmann/json.hpp>
-#include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
 #include "lampnav/core/error.hpp"
@@ -86,90 +84,6 @@ std::string base64_decode(const std::string& text) {
   return out;
 }
 
-namespace {
-
-std::string encode(const Image8& image, const char* ext, int parameter, int value) {
-  const cv::Mat m(image.height, image.width, CV_8UC1,
-                  const_cast<std::uint8_t*>(image.pixels.data()));
-  std::vector<uchar> buf;
-  cv::imencode(ext, m, buf, {parameter, value});
-  return std::string(buf.begin(), buf.end());
-}
-
-}  // namespace
-
-std::string encode_png(const Image8& image, int compression) {
-  return encode(image, ".png", cv::IMWRITE_PNG_COMPRESSION, compression);
-}
-
-std::string encode_jpeg(const Image8& image, int quality) {
-  return encode(image, ".jpg", cv::IMWRITE_JPEG_QUALITY, quality);
-}
-
-namespace {
-
-// The width and height a PNG or JPEG header declares (0, 0 when it does not say), read before
-// decoding so that a header asking for gigapixels is refused, not allocated.
-std::pair<std::uint32_t, std::uint32_t> declared_size(const std::string& b, bool png) {
-  auto u8 = [&](std::size_t i) {
-    return static_cast<std::uint32_t>(static_cast<unsigned char>(b[i]));
-  };
-  auto be16 = [&](std::size_t i) { return u8(i) << 8 | u8(i + 1); };
-  auto be32 = [&](std::size_t i) { return be16(i) << 16 | be16(i + 2); };
-  if (png) return b.size() >= 24 ? std::pair{be32(16), be32(20)} : std::pair{0u, 0u};
-  // JPEG: markers after SOI; a start-of-frame (C0..CF but C4, C8, CC) holds height then width.
-  std::size_t i = 2;
-  while (i + 9 < b.size()) {
-    if (u8(i) != 0xFF) return {0, 0};
-    const std::uint32_t marker = u8(i + 1);
-    if (marker == 0xFF) {
-      ++i;
-      continue;
-    }
-    if (marker >= 0xD0 && marker <= 0xD9) {
-      i += 2;
-      continue;
-    }
-    const std::uint32_t length = be16(i + 2);
-    if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC)
-      return {be16(i + 7), be16(i + 5)};
-    i += 2 + length;
-  }
-  return {0, 0};
-}
-
-}  // namespace
-
-Image8 decode_image(const std::string& bytes, const std::string& source) {
-  if (bytes.empty()) throw InputError({source, "", ""}, "empty image");
-  const auto* b = reinterpret_cast<const unsigned char*>(bytes.data());
-  const bool png = bytes.size() >= 8 && std::memcmp(b, "\x89PNG\r\n\x1a\n", 8) == 0;
-  const bool jpeg = bytes.size() >= 3 && b[0] == 0xFF && b[1] == 0xD8 && b[2] == 0xFF;
-  if (!png && !jpeg) throw InputError({source, "", ""}, "not a PNG or JPEG image");
-  constexpr std::uint64_t kMaxPixels = 64ull << 20;  // 8192 x 8192
-  const auto [w, h] = declared_size(bytes, png);
-  if (std::uint64_t(w) * h > kMaxPixels)
-    throw InputError({source, "", ""}, "image of " + std::to_string(w) + " x " + std::to_string(h) +
-                                           " pixels: more than lampnav reads");
-  const std::vector<uchar> buf(bytes.begin(), bytes.end());
-  cv::Mat m;
-  try {
-    m = cv::imdecode(buf, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    throw InputError({source, "", ""}, std::string("image does not decode: ") + e.what());
-  }
-  if (m.empty())
-    throw InputError({source, "", ""}, "image does not decode (not PNG or JPEG, or damaged)");
-  if (m.depth() == CV_16U) m.convertTo(m, CV_8U, 1.0 / 257.0);
-  if (m.depth() != CV_8U)
-    throw InputError({source, "", ""}, "unsupported image depth (8 or 16 bits per channel)");
-  if (m.channels() == 3) cv::cvtColor(m, m, cv::COLOR_BGR2GRAY);
-  if (m.channels() == 4) cv::cvtColor(m, m, cv::COLOR_BGRA2GRAY);
-  Image8 out(m.cols, m.rows);
-  for (int y = 0; y < m.rows; ++y)
-    std::copy_n(m.ptr<std::uint8_t>(y), m.cols, &out.pixels[static_cast<std::size_t>(y) * m.cols]);
-  return out;
-}
 
 // ---------------------------------------------------------------------------------------------
 // Writer.

@@ -98,7 +98,10 @@ void World::capture(bool is_ceiling) {
   const CameraTilt tl = tilt();
   Image8 img = is_ceiling ? ceiling_->render(pose_, tl, lamps_near(pose_, 6.0), rng_render_)
                           : omni_->render(pose_, tl, working_, rng_render_);
-  io::ImageFrame f{t, is_ceiling ? "ceiling_camera" : "omni_camera", "png", io::encode_png(img, 1)};
+  io::ImageFrame f{t, is_ceiling ? "ceiling_camera" : "omni_camera", s_.images.format_name(),
+                   io::encode_image(img, s_.images)};
+  if (s_.images.format == io::ImageEncoding::Format::jpeg)
+    img = io::decode_image(f.data, "simulated frame");
   const double delay = is_ceiling ? s_.ceiling_delay_s : s_.omni_delay_s;
   pending_.push({t_ns_ + static_cast<std::int64_t>(std::llround(delay * 1e9)), order_++,
                  std::move(f), std::move(img)});

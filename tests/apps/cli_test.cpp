@@ -143,6 +143,36 @@ TEST(Cli, SimRecordsARouteAndRefusesBadInput) {
   EXPECT_EQ(both.status, 2);
 }
 
+// Frames are stored as JPEG unless told otherwise; the format is said in each message.
+TEST(Cli, SimStoresFramesInTheFormatAsked) {
+  const auto out = std::filesystem::temp_directory_path() /
+                   ("lampnav_cli_fmt_" + std::to_string(::getpid()) + ".mcap");
+  const std::string args = "sim --map " + src("maps/office_floor.geojson") + " --robot " +
+                           src("maps/robots/pioneer.json") + " --route 'D1 -> D2' -q -o '" +
+                           out.string() + "'";
+  for (const auto& [option, format] : std::vector<std::pair<std::string, std::string>>{
+           {"", "jpeg"}, {" --image-format png", "png"}, {" --image-format jpeg:90", "jpeg"}}) {
+    const Result r = run(args + option);
+    ASSERT_EQ(r.status, 0) << r.err;
+    const io::MissionLog log = io::read_mission_log(out.string());
+    ASSERT_FALSE(log.ceiling_images.empty());
+    for (const auto& f : log.ceiling_images) ASSERT_EQ(f.value.format, format) << option;
+    const Image8 frame = io::decode_image(log.ceiling_images.front().value.data, "frame");
+    EXPECT_EQ(frame.width, 352);
+  }
+  std::filesystem::remove(out);
+  for (const auto& [bad, message] : std::vector<std::pair<std::string, std::string>>{
+           {"gif", "image format \"gif\" is not one of png, jpeg, jpeg:QUALITY (1 to 100)"},
+           {"jpeg:0", "JPEG quality \"0\" is not a whole number from 1 to 100"},
+           {"jpeg:101", "JPEG quality \"101\" is not a whole number from 1 to 100"},
+           {"jpeg:9x", "JPEG quality \"9x\" is not a whole number from 1 to 100"}}) {
+    const Result r = run(args + " --image-format '" + bad + "'");
+    EXPECT_EQ(r.status, 2) << bad;
+    EXPECT_THAT(r.err, HasSubstr("--image-format: " + message));
+    EXPECT_FALSE(std::filesystem::exists(out)) << bad;
+  }
+}
+
 // The fixture: the museum seen from (8.0, -2.5) facing 34.4 degrees (0.6 rad), floor tilted by
 // (0.23, -0.34) degrees, rendered by sim::OmniRenderer without pixel noise.
 std::string locate_args(const std::string& image) {

@@ -11,6 +11,7 @@
 #include "lampnav/fusion/global_localizer.hpp"
 #include "lampnav/fusion/merit.hpp"
 #include "lampnav/graph/geojson.hpp"
+#include "lampnav/io/image_encoding.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/sim/building.hpp"
 #include "lampnav/sim/scenario.hpp"
@@ -70,10 +71,12 @@ struct DomusRun {
   std::vector<Pose2> truth;
 };
 
-DomusRun record_domus(const std::string& scenario, double bump_deg, std::uint64_t seed) {
+DomusRun record_domus(const std::string& scenario, double bump_deg, std::uint64_t seed,
+                      const io::ImageEncoding& images = {}) {
   const Museum m;
   sim::Scenario s = sim::make_named_scenario(scenario, m.map, m.geojson, m.robot, seed);
   s.bump_sigma_rad = bump_deg * M_PI / 180;
+  s.images = images;
   const std::string path = (std::filesystem::temp_directory_path() /
                             ("lampnav_global_" + std::to_string(::getpid()) + ".mcap"))
                                .string();
@@ -127,6 +130,38 @@ TEST(GlobalLocalizer, DomusKidnapRun) {
   EXPECT_EQ(ours.found, ours.images);
   EXPECT_LE(ours.max_pos, 0.6);
   EXPECT_LE(ours.max_yaw, 5.0);
+}
+
+// Logs store the omni frames as JPEG at the default quality (io::ImageEncoding): on both Domus
+// runs every image is located as it is from the lossless PNG frames, to the centimetre.
+TEST(GlobalLocalizer, JpegFramesLocateAsPngFramesDo) {
+  io::ImageEncoding png;
+  png.format = io::ImageEncoding::Format::png;
+  const int default_quality = io::ImageEncoding{}.jpeg_quality;
+  for (const char* scenario : {"domus-global", "domus-kidnap"}) {
+    auto blobs = [](const DomusRun& run) {
+      std::size_t n = 0;
+      for (const auto& d : run.detections) n += d.blobs.size();
+      return n;
+    };
+    const DomusRun lossless_run = record_domus(scenario, 0.5, 1, png);
+    const Errors lossless = localize_all(lossless_run, GlobalMethod::lamp_pairs);
+    std::cout << scenario << ", png:     " << blobs(lossless_run) << " blobs; "
+              << lossless.summary() << "\n";
+    for (int q : {90, 50}) {
+      io::ImageEncoding jpeg;
+      jpeg.jpeg_quality = q;
+      const DomusRun run = record_domus(scenario, 0.5, 1, jpeg);
+      const Errors e = localize_all(run, GlobalMethod::lamp_pairs);
+      std::cout << scenario << ", jpeg:" << q << ": " << blobs(run) << " blobs; " << e.summary()
+                << std::endl;
+      if (q < default_quality) continue;
+      EXPECT_EQ(e.found, lossless.found) << q;
+      EXPECT_EQ(e.in_true_node, lossless.in_true_node) << q;
+      EXPECT_LE(e.mean_pos(), lossless.mean_pos() + 0.01) << q;
+      EXPECT_LE(e.max_pos, lossless.max_pos + 0.05) << q;
+    }
+  }
 }
 
 // The paper's method is a random search: its figures depend on the draw. Five seeds on the

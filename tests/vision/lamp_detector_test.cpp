@@ -1,10 +1,13 @@
 // Lamp detection on rendered ceiling frames (sim::CeilingRenderer, noise and fringe on), scored
 // against the camera model's projection of the true lamps.
 
+#include <algorithm>
 #include <cstring>
 #include <random>
 
 #include "lampnav/graph/geojson.hpp"
+#include "lampnav/io/image_encoding.hpp"
+#include "lampnav/io/mission_log.hpp"
 #include "lampnav/sim/renderers.hpp"
 #include "lampnav/vision/camera_models.hpp"
 #include "lampnav/vision/lamp_detector.hpp"
@@ -189,6 +192,81 @@ TEST(LampDetector, FindsEveryFullyVisibleLampPrecisely) {
             << " px, max orientation error " << s.max_orientation_deg
             << " deg (to the image of the lamp centre: max " << s.max_centre_of_lamp_px
             << " px, the perspective of the bumps)\n";
+}
+
+// Logs store frames as JPEG (io::ImageEncoding). The same rendered frames, lossless and through
+// JPEG at several qualities, each lamp paired with itself: at the default quality every lamp is
+// found, none invented, none seen otherwise (full, completed, partial), and the centres move by a
+// tenth of a pixel on average (0.8 mm on the ceiling).
+TEST(LampDetector, JpegFramesGiveTheSameLamps) {
+  const World w;
+  const sim::CeilingRenderer renderer(w.camera(), {});
+  LampDetector detector(w.camera(), office_prior());
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> bump(0, 0.5 * M_PI / 180);
+  std::vector<Image8> frames;
+  for (const auto& n : w.map.nodes()) {
+    if (n.place != graph::Place::corridor || !n.axis) continue;
+    const Vector2d dir = n.axis->direction();
+    for (double s = 0.3; s < n.axis->length(); s += 0.35) {
+      const Pose2 pose(n.axis->point_at(s), std::atan2(dir.y(), dir.x()));
+      frames.push_back(renderer.render(pose, {bump(rng), bump(rng)},
+                                       w.map.lamps_within(pose.translation(), 5.0), rng));
+    }
+  }
+  std::vector<LampDetections> lossless;
+  std::size_t lamps = 0;
+  for (const auto& f : frames) {
+    lossless.push_back(detector.detect(f));
+    lamps += lossless.back().lamps.size();
+  }
+  ASSERT_GT(lamps, 350u);
+  const int default_quality = io::ImageEncoding{}.jpeg_quality;
+  std::cout << frames.size() << " frames, " << lamps << " lamps\n"
+            << "quality  frame bytes  lost  new  views changed  centre shift mean / p99 / max px\n";
+  for (int q : {95, 75, 50, 30, 10}) {
+    io::ImageEncoding jpeg;
+    jpeg.jpeg_quality = q;
+    std::size_t bytes = 0;
+    int lost = 0, added = 0, views = 0;
+    std::vector<double> shift;
+    for (std::size_t k = 0; k < frames.size(); ++k) {
+      const std::string data = io::encode_image(frames[k], jpeg);
+      bytes += data.size();
+      const LampDetections d = detector.detect(io::decode_image(data, "frame"));
+      std::vector<char> paired(d.lamps.size(), 0);
+      for (const auto& a : lossless[k].lamps) {
+        int best = -1;
+        for (std::size_t j = 0; j < d.lamps.size(); ++j)
+          if (!paired[j] && (d.lamps[j].centre_px - a.centre_px).norm() < 3 &&
+              (best < 0 || (d.lamps[j].centre_px - a.centre_px).norm() <
+                               (d.lamps[best].centre_px - a.centre_px).norm()))
+            best = static_cast<int>(j);
+        if (best < 0) {
+          ++lost;
+          continue;
+        }
+        paired[best] = 1;
+        views += d.lamps[best].view != a.view;
+        if (a.view != LampView::partial)
+          shift.push_back((d.lamps[best].centre_px - a.centre_px).norm());
+      }
+      for (char p : paired) added += !p;
+    }
+    std::sort(shift.begin(), shift.end());
+    double mean = 0;
+    for (double x : shift) mean += x;
+    mean /= static_cast<double>(shift.size());
+    const double p99 = shift[shift.size() * 99 / 100], max = shift.back();
+    std::cout << "jpeg:" << q << "  " << bytes / frames.size() << "  " << lost << "  " << added
+              << "  " << views << "  " << mean << " / " << p99 << " / " << max << "\n";
+    if (q < default_quality) continue;
+    EXPECT_EQ(lost, 0) << q;
+    EXPECT_EQ(added, 0) << q;
+    EXPECT_LT(mean, 0.1) << q;
+    EXPECT_LT(p99, 0.5) << q;
+    EXPECT_EQ(views, 0) << q;
+  }
 }
 
 TEST(LampDetector, CompletesLampsCutByTheBorder) {

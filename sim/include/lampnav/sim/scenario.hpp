@@ -13,6 +13,7 @@
 #include "lampnav/core/robot_description.hpp"
 #include "lampnav/core/time.hpp"
 #include "lampnav/graph/map.hpp"
+#include "lampnav/io/image_encoding.hpp"
 #include "lampnav/sim/odometry.hpp"
 #include "lampnav/sim/renderers.hpp"
 
@@ -51,6 +52,9 @@ struct Scenario {
   OdometryErrors odometry;
   CeilingRenderOptions ceiling;
   OmniRenderOptions omni;
+  // How the log stores the frames. The simulated robot sees each frame as the log holds it (a
+  // JPEG frame decoded again), so that a replay of the log is the live run exactly.
+  io::ImageEncoding images;
   std::uint64_t seed = 1;
   double max_duration_s = 900.0;
 
