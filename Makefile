@@ -7,7 +7,7 @@ JOBS ?= $(shell nproc)
 LAMPNAV := $(BUILD_DIR)/apps/lampnav
 OUT ?= lampnav-out
 
-.PHONY: all deps configure build demo test bench format clean interop-deps test-sanitized fuzz
+.PHONY: all deps configure build demo test test-quick bench format clean interop-deps test-sanitized fuzz
 
 all: build
 
@@ -35,6 +35,11 @@ interop-deps: deps
 
 test: build interop-deps
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
+
+# The unit tests alone (ctest label quick, under a minute); `ctest -L mission` and `-L interop`
+# run the others (tests/CMakeLists.txt says which is which).
+test-quick: build
+	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L '^quick$$'
 
 # The whole suite under AddressSanitizer and UndefinedBehaviorSanitizer (GCC; any report fails the
 # test). GCC's warnings change under the sanitizers (false uninitialized warnings in Boost.Graph),
