@@ -1,11 +1,11 @@
 // The live node on DDS (issue 16's targets): `lampnav node` fed over the loopback by a player
 // process that plays the recorded corridor run at 3.05 times its pace, so the ceiling camera
-// comes at 30 Hz, the wheels at 150 Hz and the omni camera at 3 Hz, as compressed images (PNG)
-// and joint states. The node times each image from its arrival (handed over by DDS) to the pose
-// it publishes after it (decoding included); the player counts what it sent, the node what it
+// comes at 30 Hz, the wheels at 150 Hz and the omni camera at 3 Hz, as compressed images and
+// joint states. The node times each image from its arrival (handed over by DDS) to the pose it
+// publishes after it (decoding included); the player counts what it sent, the node what it
 // received. The iteration time is the ceiling camera's p99; the rest are counters. Run twice:
-// the images as the simulator writes them (PNG: a 1024 x 1024 omni frame takes 11 ms to decode
-// alone), and as most camera drivers compress them (JPEG, quality 90; argument 90).
+// the images as PNG (a 1024 x 1024 omni frame takes 11 ms to decode alone), and as most camera
+// drivers compress them (JPEG, quality 90; argument 90).
 //   Targets: image in to pose out at most 5 ms (p99); no message lost.
 
 #include <benchmark/benchmark.h>
@@ -40,7 +40,11 @@ void BM_NodeImageToPose(benchmark::State& state) {
   const graph::TopologicalMap map = graph::parse_map(text, "office_floor.geojson").map;
   const RobotDescription robot = read_robot_description(src + "/maps/robots/pioneer.json");
   const std::string log = dir + "/corridor.mcap";
-  sim::record_mission(sim::make_named_scenario("corridor", map, text, robot, 1), log);
+  // Recorded as PNG: the player sends those bytes, or JPEG at the argument's quality made from
+  // them.
+  sim::Scenario scenario = sim::make_named_scenario("corridor", map, text, robot, 1);
+  scenario.images.format = io::ImageEncoding::Format::png;
+  sim::record_mission(scenario, log);
   const io::MissionLog mission = io::read_mission_log(log);
   const double messages = static_cast<double>(
       mission.wheels.size() + mission.ceiling_images.size() + mission.omni_images.size());

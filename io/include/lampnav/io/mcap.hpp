@@ -51,7 +51,7 @@ struct McapWriterOptions {
   bool chunked = true;                  // false writes messages straight into the data section
   std::size_t chunk_size = 512 * 1024;  // bytes of records buffered before a chunk is written
   bool summary = true;                  // false leaves out the summary (an unindexed file)
-  int zstd_level = 1;  // 1 writes fastest; on JPEG frames higher levels save under 1% (make bench)
+  int zstd_level = 1;  // the fastest; 3 saves 5 % on a log of JPEG frames, 9 saves 9 % (make bench)
 };
 
 class McapWriter {
