@@ -5,6 +5,7 @@
 #include <visp3/core/vpImage.h>
 
 #include <algorithm>
+#include <memory>
 #include <string>
 
 namespace lampnav::vision {
@@ -35,7 +36,9 @@ struct LampTracker::Impl {
   LampDetector detector;
   LampTrackerOptions o;
   unsigned threshold;
-  std::vector<Track> tracks;
+  // vpDot2 has no move: it would copy its outline (lists of edge points) whenever a track moved
+  // in the vector, hundreds of allocations a frame. The tracks stay where they were made.
+  std::vector<std::unique_ptr<Track>> tracks;
   std::vector<int> pending_ended;  // from reset()
   int next_id = 1;
   std::vector<std::uint8_t> grey, half;
@@ -88,9 +91,10 @@ TrackedFrame LampTracker::Impl::process(const ImageView& image) {
     return Eigen::Vector2d(2 * p.get_u() + 0.5, 2 * p.get_v() + 0.5);
   };
   std::vector<int> owner(found.lamps.size(), -1);  // detection -> track index
-  std::vector<Track> kept;
+  std::vector<std::unique_ptr<Track>> kept;
   kept.reserve(tracks.size());
-  for (auto& t : tracks) {
+  for (auto& tp : tracks) {
+    Track& t = *tp;
     const vpImagePoint before = t.dot.getCog();
     bool alive = true;
     try {
@@ -129,19 +133,19 @@ TrackedFrame LampTracker::Impl::process(const ImageView& image) {
     }
     owner[match] = static_cast<int>(kept.size());
     ++t.age;
-    kept.push_back(std::move(t));
+    kept.push_back(std::move(tp));
   }
   tracks = std::move(kept);
   // Lamps no track claimed start new tracks, seeded on a pixel of their blob.
   for (std::size_t k = 0; k < found.lamps.size(); ++k) {
     if (owner[k] >= 0 || static_cast<int>(tracks.size()) >= o.max_tracks) continue;
-    Track t;
-    t.id = next_id++;
-    t.age = 1;
-    configure(t.dot);
+    auto t = std::make_unique<Track>();
+    t->id = next_id++;
+    t->age = 1;
+    configure(t->dot);
     const auto& seed = found.lamps[k].seed;
     try {
-      t.dot.initTracking(I, vpImagePoint(seed[1] / 2, seed[0] / 2), threshold, 255);
+      t->dot.initTracking(I, vpImagePoint(seed[1] / 2, seed[0] / 2), threshold, 255);
     } catch (const vpException&) {
       continue;  // the blob is not trackable (vpDot2 refused it); it is detected again next frame
     }
@@ -150,7 +154,7 @@ TrackedFrame LampTracker::Impl::process(const ImageView& image) {
   }
   for (std::size_t k = 0; k < found.lamps.size(); ++k) {
     if (owner[k] < 0) continue;
-    const Track& t = tracks[owner[k]];
+    const Track& t = *tracks[owner[k]];
     out.lamps.push_back({t.id, t.age, t.age == 1, found.lamps[k]});
   }
   std::sort(out.lamps.begin(), out.lamps.end(),
@@ -168,7 +172,7 @@ LampTracker& LampTracker::operator=(LampTracker&&) noexcept = default;
 TrackedFrame LampTracker::process(const ImageView& image) { return impl_->process(image); }
 
 void LampTracker::reset() {
-  for (const auto& t : impl_->tracks) impl_->pending_ended.push_back(t.id);
+  for (const auto& t : impl_->tracks) impl_->pending_ended.push_back(t->id);
   impl_->tracks.clear();
 }
 
