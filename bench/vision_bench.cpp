@@ -78,18 +78,34 @@ void BM_LampDetector(benchmark::State& state) {
 }
 BENCHMARK(BM_LampDetector)->Arg(352)->Arg(640)->Unit(benchmark::kMicrosecond);
 
-// Detection plus vpDot2 tracking, frames in driving order.
-void BM_LampDetectAndTrack(benchmark::State& state) {
+// Detection plus tracking, frames in driving order: windowed (the default: a frame read whole
+// every 10, or when the windows cannot vouch for it), or every frame read whole.
+void detect_and_track(benchmark::State& state, int full_detection_every) {
   const Frames& f = frames(static_cast<int>(state.range(0)));
-  vision::LampTracker tracker(f.camera(), vision::LampShapePrior{});
-  std::size_t i = 0;
+  vision::LampTrackerOptions o;
+  o.full_detection_every = full_detection_every;
+  vision::LampTracker tracker(f.camera(), vision::LampShapePrior{}, {}, o);
+  std::size_t i = 0, whole = 0;
+  double pixels = 0;
   for (auto _ : state) {
     if (i % f.images.size() == 0) tracker.reset();  // the drive starts again
     const auto t = tracker.process(f.images[i++ % f.images.size()]);
+    whole += t.whole ? 1 : 0;
+    pixels += static_cast<double>(t.pixels_read);
     benchmark::DoNotOptimize(t);
   }
+  const double frame = static_cast<double>(f.images.front().width) * f.images.front().height;
+  state.counters["whole_frames"] = static_cast<double>(whole) / state.iterations();
+  state.counters["pixels_read"] = pixels / frame / state.iterations();
+}
+
+void BM_LampDetectAndTrack(benchmark::State& state) {
+  detect_and_track(state, vision::LampTrackerOptions{}.full_detection_every);
 }
 BENCHMARK(BM_LampDetectAndTrack)->Arg(352)->Arg(640)->Unit(benchmark::kMicrosecond);
+
+void BM_LampDetectAndTrackWholeFrames(benchmark::State& state) { detect_and_track(state, 1); }
+BENCHMARK(BM_LampDetectAndTrackWholeFrames)->Arg(352)->Arg(640)->Unit(benchmark::kMicrosecond);
 
 // OpenCV's SimpleBlobDetector on the same frames, bright blobs of a lamp's area. `thresholds`:
 // 1 gives it our single threshold (its fastest use); 18 is its own default sweep (50 to 220 in

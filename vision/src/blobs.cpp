@@ -14,16 +14,27 @@ int BlobLabeller::find_root(int i) {
 }
 
 void BlobLabeller::label(const ImageView& g, std::uint8_t t) {
-  const int w = g.width, h = g.height;
+  label(g, t, PixelBox{0, 0, g.width - 1, g.height - 1});
+}
+
+void BlobLabeller::label(const ImageView& g, std::uint8_t t, const PixelBox& requested) {
+  box_ = {std::max(requested.u0, 0), std::max(requested.v0, 0), std::min(requested.u1, g.width - 1),
+          std::min(requested.v1, g.height - 1)};
+  runs_.clear();
+  blobs_.clear();
+  sorted_.clear();
+  width_ = 0;
+  if (box_.empty()) return;
+  const int w = box_.u1 - box_.u0 + 1, h = box_.v1 - box_.v0 + 1;
+  const int du = box_.u0, dv = box_.v0;  // box -> image coordinates
   width_ = w;
-  height_ = h;
   binary_.resize(static_cast<std::size_t>(w) * h);
   for (int v = 0; v < h; ++v) {  // a plain loop the compiler vectorizes; no thread pool
-    const std::uint8_t* __restrict in = g.data + static_cast<std::size_t>(v) * g.row_stride();
+    const std::uint8_t* __restrict in =
+        g.data + static_cast<std::size_t>(v + dv) * g.row_stride() + du;
     std::uint8_t* __restrict out = binary_.data() + static_cast<std::size_t>(v) * w;
     for (int u = 0; u < w; ++u) out[u] = in[u] >= t ? 1 : 0;
   }
-  runs_.clear();
   int prev_begin = 0, prev_end = 0;
   for (int v = 0; v < h; ++v) {
     const std::uint8_t* b = binary_.data() + static_cast<std::size_t>(v) * w;
@@ -41,12 +52,12 @@ void BlobLabeller::label(const ImageView& g, std::uint8_t t) {
       const int start = u;
       while (u < w && b[u] != 0) ++u;
       const int id = static_cast<int>(runs_.size());
-      runs_.push_back({v, start, u - 1, id});
+      runs_.push_back({v + dv, start + du, u - 1 + du, id});
     }
     const int cur_end = static_cast<int>(runs_.size());
     int j0 = prev_begin;
     for (int c = cur_begin; c < cur_end; ++c) {
-      while (j0 < prev_end && runs_[j0].u1 < runs_[c].u0 - 1) ++j0;
+      while (j0 < prev_end && runs_[j0].u1 < runs_[c].u0 - 1) ++j0;  // (image coordinates)
       for (int j = j0; j < prev_end && runs_[j].u0 <= runs_[c].u1 + 1; ++j) {
         const int ra = find_root(j), rb = find_root(c);
         if (ra != rb) runs_[std::max(ra, rb)].parent = std::min(ra, rb);

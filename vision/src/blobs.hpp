@@ -27,22 +27,26 @@ class BlobLabeller {
   // Labels the pixels >= `threshold` of an 8-bit grey image of width x height. The scratch is
   // kept from call to call: no allocation once the sizes have settled.
   void label(const ImageView& grey, std::uint8_t threshold);
+  // The same within `box` only (clipped to the image): runs, blobs and bright() keep the image's
+  // coordinates, and pixels outside the box count as dark.
+  void label(const ImageView& grey, std::uint8_t threshold, const PixelBox& box);
 
   const std::vector<Blob>& blobs() const { return blobs_; }
   // The runs of blob b are run(b.first_run) .. run(b.first_run + b.run_count - 1).
   const Run& run(int k) const { return runs_[sorted_[k]]; }
-  // 0/1 per pixel, row-major, of the last label() call; 0 outside the image.
+  // 0/1 per pixel of the last label() call; 0 outside the labelled box.
   std::uint8_t bright(int u, int v) const {
-    return u < 0 || v < 0 || u >= width_ || v >= height_
+    return !box_.contains(u, v)
                ? 0
-               : binary_[static_cast<std::size_t>(v) * width_ + u];
+               : binary_[static_cast<std::size_t>(v - box_.v0) * width_ + (u - box_.u0)];
   }
   // Blob pixels with a 4-neighbour that is dark or outside the image.
   int perimeter(const Blob& b) const;
 
  private:
   int find_root(int i);
-  int width_ = 0, height_ = 0;
+  PixelBox box_;     // the labelled pixels
+  int width_ = 0;    // of box_
   std::vector<std::uint8_t> binary_;
   std::vector<Run> runs_;
   std::vector<int> sorted_, blob_of_root_, blob_of_run_;

@@ -242,6 +242,9 @@ struct LampDetector::Impl {
   std::size_t index(int u, int v) const { return static_cast<std::size_t>(v) * w + u; }
 
   LampDetections detect(const ImageView& image);
+  LampDetections detect_in(const ImageView& image, std::vector<PixelBox> windows);
+  // Measures the blobs of the last labelling into `out`; false when one spills out of `box`.
+  bool measure_blobs(const ImageView& g, const PixelBox& box, LampDetections& out);
   bool measure(const detail::Blob& c, const ImageView& g, LampDetection& out, DetectionStats& st);
   bool complete(const detail::Blob& c, const ImageView& g, int pad, LampDetection& out);
 };
@@ -251,20 +254,70 @@ LampDetections LampDetector::Impl::detect(const ImageView& image) {
   const ImageView g = grey_view(image, grey);
   blobs.label(g, static_cast<std::uint8_t>(o.threshold));
   LampDetections out;
-  out.stats.blobs = static_cast<int>(blobs.blobs().size());
-  for (const detail::Blob& c : blobs.blobs()) {
-    if (c.pixels < min_pixels) {
-      ++out.stats.too_small;
-      continue;
+  out.pixels_read = static_cast<long>(w) * h;
+  measure_blobs(g, PixelBox{0, 0, w - 1, h - 1}, out);
+  return out;
+}
+
+LampDetections LampDetector::Impl::detect_in(const ImageView& image, std::vector<PixelBox> windows) {
+  check_image(image, w, h, {"", "image", ""});
+  const ImageView g = grey_view(image, grey);
+  for (auto& b : windows) b = {std::max(b.u0, 0), std::max(b.v0, 0), std::min(b.u1, w - 1),
+                               std::min(b.v1, h - 1)};
+  windows.erase(std::remove_if(windows.begin(), windows.end(),
+                               [](const PixelBox& b) { return b.empty(); }),
+                windows.end());
+  // Overlapping windows become their bounding box, until none overlap: a blob is then read once.
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (std::size_t i = 0; i < windows.size() && !merged; ++i) {
+      for (std::size_t j = i + 1; j < windows.size(); ++j) {
+        if (!windows[i].overlaps(windows[j])) continue;
+        PixelBox& a = windows[i];
+        const PixelBox& b = windows[j];
+        a = {std::min(a.u0, b.u0), std::min(a.v0, b.v0), std::max(a.u1, b.u1),
+             std::max(a.v1, b.v1)};
+        windows.erase(windows.begin() + static_cast<std::ptrdiff_t>(j));
+        merged = true;
+        break;
+      }
     }
-    if (c.pixels > max_pixels) {
-      ++out.stats.too_large;
-      continue;
+  }
+  LampDetections out;
+  for (const PixelBox& box : windows) {
+    out.pixels_read += box.area();
+    blobs.label(g, static_cast<std::uint8_t>(o.threshold), box);
+    if (!measure_blobs(g, box, out)) {
+      out.spilled = true;
+      return out;
     }
-    LampDetection d;
-    if (measure(c, g, d, out.stats)) out.lamps.push_back(d);
   }
   return out;
+}
+
+bool LampDetector::Impl::measure_blobs(const ImageView& g, const PixelBox& box,
+                                       LampDetections& out) {
+  // A blob on an edge of the box that is not the image's own edge may go on outside the box.
+  for (const detail::Blob& c : blobs.blobs()) {
+    if ((c.u0 == box.u0 && box.u0 > 0) || (c.v0 == box.v0 && box.v0 > 0) ||
+        (c.u1 == box.u1 && box.u1 < w - 1) || (c.v1 == box.v1 && box.v1 < h - 1))
+      return false;
+  }
+  out.stats.blobs += static_cast<int>(blobs.blobs().size());
+  for (const detail::Blob& c : blobs.blobs()) {
+    const std::size_t before = out.lamps.size();
+    if (c.pixels < min_pixels) {
+      ++out.stats.too_small;
+    } else if (c.pixels > max_pixels) {
+      ++out.stats.too_large;
+    } else {
+      LampDetection d;
+      if (measure(c, g, d, out.stats)) out.lamps.push_back(d);
+    }
+    const bool at_border = c.u0 == 0 || c.v0 == 0 || c.u1 == w - 1 || c.v1 == h - 1;
+    if (at_border && out.lamps.size() == before) out.border_blobs.push_back({c.u0, c.v0, c.u1, c.v1});
+  }
+  return true;
 }
 
 bool LampDetector::Impl::measure(const detail::Blob& c, const ImageView& g, LampDetection& out,
@@ -389,35 +442,39 @@ bool LampDetector::Impl::complete(const detail::Blob& c, const ImageView& g, int
                                   LampDetection& out) {
   edges.clear();
   const double level = o.threshold - 0.5;
-  auto inside = [&](int u, int v) {
-    if (u < c.u0 || u > c.u1 || v < c.v0 || v > c.v1) return false;
-    const int mw = c.u1 - c.u0 + 1 + 2 * pad;  // the mask measure() opened
-    return opened[static_cast<std::size_t>(v - c.v0 + pad) * mw + (u - c.u0 + pad)] != 0;
-  };
-  auto grey_at = [&](int u, int v) {
-    return static_cast<double>(g.data[static_cast<std::size_t>(v) * g.row_stride() + u]);
+  // The opened mask of measure(), padded: a pixel's 4-neighbours are always in it. Inside the
+  // image it is the visible lamp exactly (its extension past a cut lies outside the image).
+  const int mw = c.u1 - c.u0 + 1 + 2 * pad;
+  auto edge = [&](int u, int v, int un, int vn, std::uint8_t gi, std::uint8_t go) {
+    const double t = gi > go ? std::clamp((gi - level) / (gi - go), 0.0, 1.0) : 0.5;
+    const std::size_t a = index(u, v), b = index(un, vn);
+    edges.emplace_back(lut_x[a] + t * (lut_x[b] - lut_x[a]), lut_y[a] + t * (lut_y[b] - lut_y[a]));
   };
   // Border pixels of the cut tell on which side of the visible part the rest of the lamp lies.
   Vector2d border_sum = Vector2d::Zero();
   int border_n = 0;
-  static const int du[4] = {1, -1, 0, 0}, dv[4] = {0, 0, 1, -1};
+  const std::size_t stride = g.row_stride();
   for (int v = c.v0; v <= c.v1; ++v) {
+    const std::uint8_t* row = opened.data() + static_cast<std::size_t>(v - c.v0 + pad) * mw + pad;
+    const std::uint8_t* grey_row = g.data + static_cast<std::size_t>(v) * stride;
     for (int u = c.u0; u <= c.u1; ++u) {
-      if (!inside(u, v)) continue;
-      if (u == 0 || v == 0 || u == w - 1 || v == h - 1) {
+      const int j = u - c.u0;
+      if (!row[j]) continue;
+      const bool left = u > 0 && !row[j - 1], right = u < w - 1 && !row[j + 1];
+      const bool below = v < h - 1 && !row[j + mw], above = v > 0 && !row[j - mw];
+      const bool at_border = u == 0 || v == 0 || u == w - 1 || v == h - 1;
+      if (at_border) {
         const std::size_t i = index(u, v);
         border_sum += Vector2d(lut_x[i], lut_y[i]);
         ++border_n;
       }
-      for (int k = 0; k < 4; ++k) {
-        const int un = u + du[k], vn = v + dv[k];
-        if (un < 0 || vn < 0 || un >= w || vn >= h || inside(un, vn)) continue;
-        const double gi = grey_at(u, v), go = grey_at(un, vn);
-        const double t = gi > go ? std::clamp((gi - level) / (gi - go), 0.0, 1.0) : 0.5;
-        const std::size_t a = index(u, v), b = index(un, vn);
-        edges.emplace_back(lut_x[a] + t * (lut_x[b] - lut_x[a]),
-                           lut_y[a] + t * (lut_y[b] - lut_y[a]));
-      }
+      if (!(left || right || below || above)) continue;
+      const std::uint8_t gi = grey_row[u];
+      // The neighbours in the order right, left, below, above.
+      if (right) edge(u, v, u + 1, v, gi, grey_row[u + 1]);
+      if (left) edge(u, v, u - 1, v, gi, grey_row[u - 1]);
+      if (below) edge(u, v, u, v + 1, gi, (grey_row + stride)[u]);
+      if (above) edge(u, v, u, v - 1, gi, (grey_row - stride)[u]);
     }
   }
   if (edges.size() < 16 || border_n == 0) return false;
@@ -469,6 +526,9 @@ LampDetector::LampDetector(LampDetector&&) noexcept = default;
 LampDetector& LampDetector::operator=(LampDetector&&) noexcept = default;
 
 LampDetections LampDetector::detect(const ImageView& image) { return impl_->detect(image); }
+LampDetections LampDetector::detect_in(const ImageView& image, std::vector<PixelBox> windows) {
+  return impl_->detect_in(image, std::move(windows));
+}
 double LampDetector::expected_area() const { return impl_->area_nominal; }
 const LampShapePrior& LampDetector::prior() const { return impl_->prior; }
 const LampDetectorOptions& LampDetector::options() const { return impl_->o; }

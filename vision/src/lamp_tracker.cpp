@@ -1,21 +1,25 @@
 #include "lampnav/vision/lamp_tracker.hpp"
 
-#include <visp3/blob/vpDot2.h>
-#include <visp3/core/vpException.h>
-#include <visp3/core/vpImage.h>
-
 #include <algorithm>
+#include <cmath>
 #include <memory>
+#include <optional>
 #include <string>
 
 namespace lampnav::vision {
 
+using Eigen::Vector2d;
+
 void LampTrackerOptions::validate() const {
+  const char* what = "lamp tracker options";
   if (max_tracks < 1 || max_tracks > 1000)
-    throw InputError({"", "lamp tracker options", "max_tracks"}, "must be 1 to 1000");
+    throw InputError({"", what, "max_tracks"}, "must be 1 to 1000");
   if (!(max_step_px > 0 && max_step_px < 10000))
-    throw InputError({"", "lamp tracker options", "max_step_px"},
-                     "must be a positive number of px");
+    throw InputError({"", what, "max_step_px"}, "must be a positive number of px");
+  if (full_detection_every < 1 || full_detection_every > 1000)
+    throw InputError({"", what, "full_detection_every"}, "must be 1 to 1000 frames");
+  if (window_margin_px < 1 || window_margin_px > 200)
+    throw InputError({"", what, "window_margin_px"}, "must be 1 to 200 px");
 }
 
 namespace {
@@ -23,45 +27,172 @@ namespace {
 struct Track {
   int id = 0;
   int age = 0;
-  vpDot2 dot;
+  LampDetection last;             // its lamp in the last frame
+  Vector2d velocity{0, 0};        // px a frame, of the lamp's centre
+  double unsure = 0;              // px: the last change of velocity (the prediction's error)
+  bool moving_known = false;      // velocity measured (two whole views of the lamp)
+  Vector2d predicted() const { return last.centre_px + velocity; }
 };
 
-bool contains(const std::array<int, 4>& box, double u, double v) {
-  return u >= box[0] - 1 && u <= box[2] + 1 && v >= box[1] - 1 && v <= box[3] + 1;
+bool whole_view(const LampDetection& d) { return d.view != LampView::partial; }
+
+PixelBox grown(const PixelBox& b, int by) {
+  return {b.u0 - by, b.v0 - by, b.u1 + by, b.v1 + by};
 }
+
+PixelBox as_box(const std::array<int, 4>& b) { return {b[0], b[1], b[2], b[3]}; }
 
 }  // namespace
 
 struct LampTracker::Impl {
   LampDetector detector;
   LampTrackerOptions o;
-  unsigned threshold;
-  // vpDot2 has no move: it would copy its outline (lists of edge points) whenever a track moved
-  // in the vector, hundreds of allocations a frame. The tracks stay where they were made.
-  std::vector<std::unique_ptr<Track>> tracks;
+  std::uint8_t threshold;
+  std::vector<Track> tracks;      // oldest first
+  std::vector<PixelBox> watched;  // border blobs of the last frame that were not lamps
   std::vector<int> pending_ended;  // from reset()
   int next_id = 1;
-  std::vector<std::uint8_t> grey, half;
+  int since_whole = 1 << 20;  // frames since the last frame read whole; huge: read the next whole
+  std::vector<std::uint8_t> grey;
 
   Impl(const CameraDescription& camera, const LampShapePrior& prior,
        const LampDetectorOptions& detector_options, const LampTrackerOptions& options)
       : detector(camera, prior, detector_options),
         o(options),
-        threshold(static_cast<unsigned>(detector_options.threshold)) {
+        threshold(static_cast<std::uint8_t>(detector_options.threshold)) {
     o.validate();
   }
 
-  void configure(vpDot2& dot) const {
-    dot.setGraphics(false);
-    dot.setComputeMoments(false);       // the detector measures; vpDot2 only follows the blob
-    dot.setEllipsoidShapePrecision(0);  // lamps are rectangles, not ellipses
-    dot.setSizePrecision(0);            // a lamp entering the view grows frame after frame
-    dot.setGrayLevelMin(threshold);
-    dot.setGrayLevelMax(255);
-  }
-
   TrackedFrame process(const ImageView& image);
+  // The windows of the next frame, or nothing when it must be read whole.
+  std::optional<std::vector<PixelBox>> windows() const;
+  // Something bright on the image's border ring outside every window: a lamp entering unseen.
+  bool ring_unexplained(const ImageView& g, const std::vector<PixelBox>& boxes) const;
+  // Gives the detections to the tracks; false when a track found no lamp (windowed frames: the
+  // frame is then read whole, the verdict is the full detection's).
+  bool associate(const LampDetections& found, bool windowed, TrackedFrame& out);
 };
+
+std::optional<std::vector<PixelBox>> LampTracker::Impl::windows() const {
+  if (since_whole + 1 >= o.full_detection_every) return std::nullopt;
+  // The ceiling moves as one under a translation: a track whose own motion is not measured yet
+  // borrows the mean of the others'; with none, its window covers any allowed step.
+  Vector2d mean{0, 0};
+  int known = 0;
+  double fastest = 0;
+  for (const Track& t : tracks) {
+    if (!t.moving_known) continue;
+    mean += t.velocity;
+    ++known;
+    fastest = std::max(fastest, t.velocity.norm() + t.unsure);
+  }
+  if (known > 0) mean /= known;
+  std::vector<PixelBox> boxes;
+  for (const Track& t : tracks) {
+    const Vector2d v = t.moving_known ? t.velocity : mean;
+    const int margin = o.window_margin_px + static_cast<int>(std::ceil(
+                                               t.moving_known ? t.unsure
+                                               : known > 0    ? 2 * o.window_margin_px
+                                                              : o.max_step_px));
+    // Where the lamp was and where it goes: a lamp cut by the border shrinks or grows there.
+    const PixelBox b = as_box(t.last.bbox);
+    const int du = static_cast<int>(std::lround(v.x())), dv = static_cast<int>(std::lround(v.y()));
+    boxes.push_back(grown({std::min(b.u0, b.u0 + du), std::min(b.v0, b.v0 + dv),
+                           std::max(b.u1, b.u1 + du), std::max(b.v1, b.v1 + dv)},
+                          margin));
+  }
+  const int step = o.window_margin_px +
+                   static_cast<int>(std::ceil(known > 0 ? fastest : o.max_step_px));
+  for (const PixelBox& b : watched) boxes.push_back(grown(b, step));
+  return boxes;
+}
+
+bool LampTracker::Impl::ring_unexplained(const ImageView& g, const std::vector<PixelBox>& boxes)
+    const {
+  const int w = g.width, h = g.height;
+  auto bright = [&](int u, int v) {
+    return g.data[static_cast<std::size_t>(v) * g.row_stride() + u] >= threshold;
+  };
+  auto explained = [&](int u, int v) {
+    for (const PixelBox& b : boxes)
+      if (b.contains(u, v)) return true;
+    return false;
+  };
+  for (int u = 0; u < w; ++u) {
+    if (bright(u, 0) && !explained(u, 0)) return true;
+    if (bright(u, h - 1) && !explained(u, h - 1)) return true;
+  }
+  for (int v = 1; v < h - 1; ++v) {
+    if (bright(0, v) && !explained(0, v)) return true;
+    if (bright(w - 1, v) && !explained(w - 1, v)) return true;
+  }
+  return false;
+}
+
+bool LampTracker::Impl::associate(const LampDetections& found, bool windowed, TrackedFrame& out) {
+  std::vector<int> owner(found.lamps.size(), -1);  // detection -> track index
+  std::vector<int> match_of(tracks.size(), -1);
+  for (std::size_t i = 0; i < tracks.size(); ++i) {
+    const Vector2d p = tracks[i].predicted();
+    double best = o.max_step_px;
+    for (std::size_t k = 0; k < found.lamps.size(); ++k) {
+      const double d = (found.lamps[k].centre_px - p).norm();
+      if (d <= best) {
+        best = d;
+        match_of[i] = static_cast<int>(k);
+      }
+    }
+    // No lamp where the track's lamp should be (it left the view, shrank below the area filter,
+    // went out), or an older track holds it (two blobs merged): the track ends.
+    const int k = match_of[i];
+    if (k >= 0 && owner[k] < 0) {
+      owner[k] = static_cast<int>(i);
+    } else {
+      if (windowed) return false;
+      match_of[i] = -1;
+    }
+  }
+  std::vector<Track> kept;
+  kept.reserve(tracks.size() + found.lamps.size());
+  for (std::size_t i = 0; i < tracks.size(); ++i) {
+    Track& t = tracks[i];
+    if (match_of[i] < 0) {
+      out.ended.push_back(t.id);
+      continue;
+    }
+    const LampDetection& d = found.lamps[match_of[i]];
+    if (whole_view(d) && whole_view(t.last)) {
+      const Vector2d v = d.centre_px - t.last.centre_px;
+      t.unsure = t.moving_known ? (v - t.velocity).norm() : 0.0;
+      t.velocity = v;
+      t.moving_known = true;
+    }
+    t.last = d;
+    ++t.age;
+    owner[match_of[i]] = static_cast<int>(kept.size());
+    kept.push_back(std::move(t));
+  }
+  tracks = std::move(kept);
+  // Lamps no track claimed start new tracks.
+  for (std::size_t k = 0; k < found.lamps.size(); ++k) {
+    if (owner[k] >= 0 || static_cast<int>(tracks.size()) >= o.max_tracks) continue;
+    Track t;
+    t.id = next_id++;
+    t.age = 1;
+    t.last = found.lamps[k];
+    owner[k] = static_cast<int>(tracks.size());
+    tracks.push_back(std::move(t));
+  }
+  for (std::size_t k = 0; k < found.lamps.size(); ++k) {
+    if (owner[k] < 0) continue;
+    const Track& t = tracks[owner[k]];
+    out.lamps.push_back({t.id, t.age, t.age == 1, found.lamps[k]});
+  }
+  std::sort(out.lamps.begin(), out.lamps.end(),
+            [](const TrackedLamp& a, const TrackedLamp& b) { return a.track_id < b.track_id; });
+  watched = found.border_blobs;
+  return true;
+}
 
 TrackedFrame LampTracker::Impl::process(const ImageView& image) {
   check_image(image, detector.width(), detector.height(), {"", "image", ""});
@@ -69,96 +200,28 @@ TrackedFrame LampTracker::Impl::process(const ImageView& image) {
   TrackedFrame out;
   out.ended = std::move(pending_ended);
   pending_ended.clear();
-  LampDetections found = detector.detect(g);
-  out.stats = found.stats;
-  // vpDot2 follows each blob's outline; at half resolution the outline, and vpDot2's per-frame
-  // copy of it, is half as long. Identity needs no more: the detector measures at full resolution.
-  const int hw = g.width / 2, hh = g.height / 2;
-  half.resize(static_cast<std::size_t>(hw) * hh);
-  for (int v = 0; v < hh; ++v) {
-    const std::uint8_t* __restrict a = g.data + static_cast<std::size_t>(2 * v) * g.row_stride();
-    const std::uint8_t* __restrict b = a + g.row_stride();
-    std::uint8_t* __restrict dst = half.data() + static_cast<std::size_t>(v) * hw;
-    for (int u = 0; u < hw; ++u) {
-      dst[u] =
-          static_cast<std::uint8_t>((a[2 * u] + a[2 * u + 1] + b[2 * u] + b[2 * u + 1] + 2) >> 2);
-    }
-  }
-  const vpImage<unsigned char> I(half.data(), static_cast<unsigned>(hh), static_cast<unsigned>(hw),
-                                 false);
-  // Half-resolution pixel centre (i, j) covers full-resolution pixels 2i, 2i + 1.
-  auto to_full = [](const vpImagePoint& p) {
-    return Eigen::Vector2d(2 * p.get_u() + 0.5, 2 * p.get_v() + 0.5);
-  };
-  std::vector<int> owner(found.lamps.size(), -1);  // detection -> track index
-  std::vector<std::unique_ptr<Track>> kept;
-  kept.reserve(tracks.size());
-  for (auto& tp : tracks) {
-    Track& t = *tp;
-    const vpImagePoint before = t.dot.getCog();
-    bool alive = true;
-    try {
-      // track() narrows the grey-level band around the blob's mean; a lamp is any pixel above
-      // the detector's threshold, frame after frame.
-      t.dot.setGrayLevelMin(threshold);
-      t.dot.setGrayLevelMax(255);
-      t.dot.track(I);
-    } catch (const vpException&) {
-      alive = false;
-    }
-    int match = -1;
-    if (alive) {
-      const Eigen::Vector2d cog = to_full(t.dot.getCog());
-      if ((cog - to_full(before)).norm() > o.max_step_px) {
-        alive = false;
-      } else {
-        double best = 1e18;
-        for (std::size_t k = 0; k < found.lamps.size(); ++k) {
-          const auto& d = found.lamps[k];
-          if (!contains(d.bbox, cog.x(), cog.y())) continue;
-          const double dist = (d.centre_px - cog).norm();
-          if (dist < best) {
-            best = dist;
-            match = static_cast<int>(k);
-          }
+  if (const auto boxes = windows()) {
+    const long ring = 2L * (g.width + g.height) - 4;
+    if (!ring_unexplained(g, *boxes)) {
+      LampDetections found = detector.detect_in(g, *boxes);
+      if (!found.spilled) {
+        TrackedFrame windowed = out;
+        if (associate(found, true, windowed)) {
+          windowed.stats = found.stats;
+          windowed.whole = false;
+          windowed.pixels_read = found.pixels_read + ring;
+          ++since_whole;
+          return windowed;
         }
-        // No lamp-like blob where the track went (it left the view, or shrank below the area
-        // filter), or an older track already holds that blob (two blobs merged): the track ends.
-        if (match < 0 || owner[match] >= 0) alive = false;
       }
     }
-    if (!alive) {
-      out.ended.push_back(t.id);
-      continue;
-    }
-    owner[match] = static_cast<int>(kept.size());
-    ++t.age;
-    kept.push_back(std::move(tp));
   }
-  tracks = std::move(kept);
-  // Lamps no track claimed start new tracks, seeded on a pixel of their blob.
-  for (std::size_t k = 0; k < found.lamps.size(); ++k) {
-    if (owner[k] >= 0 || static_cast<int>(tracks.size()) >= o.max_tracks) continue;
-    auto t = std::make_unique<Track>();
-    t->id = next_id++;
-    t->age = 1;
-    configure(t->dot);
-    const auto& seed = found.lamps[k].seed;
-    try {
-      t->dot.initTracking(I, vpImagePoint(seed[1] / 2, seed[0] / 2), threshold, 255);
-    } catch (const vpException&) {
-      continue;  // the blob is not trackable (vpDot2 refused it); it is detected again next frame
-    }
-    owner[k] = static_cast<int>(tracks.size());
-    tracks.push_back(std::move(t));
-  }
-  for (std::size_t k = 0; k < found.lamps.size(); ++k) {
-    if (owner[k] < 0) continue;
-    const Track& t = *tracks[owner[k]];
-    out.lamps.push_back({t.id, t.age, t.age == 1, found.lamps[k]});
-  }
-  std::sort(out.lamps.begin(), out.lamps.end(),
-            [](const TrackedLamp& a, const TrackedLamp& b) { return a.track_id < b.track_id; });
+  const LampDetections found = detector.detect(g);
+  associate(found, false, out);
+  out.stats = found.stats;
+  out.whole = true;
+  out.pixels_read = found.pixels_read;
+  since_whole = 0;
   return out;
 }
 
@@ -172,8 +235,10 @@ LampTracker& LampTracker::operator=(LampTracker&&) noexcept = default;
 TrackedFrame LampTracker::process(const ImageView& image) { return impl_->process(image); }
 
 void LampTracker::reset() {
-  for (const auto& t : impl_->tracks) impl_->pending_ended.push_back(t->id);
+  for (const auto& t : impl_->tracks) impl_->pending_ended.push_back(t.id);
   impl_->tracks.clear();
+  impl_->watched.clear();
+  impl_->since_whole = 1 << 20;
 }
 
 int LampTracker::live_tracks() const { return static_cast<int>(impl_->tracks.size()); }

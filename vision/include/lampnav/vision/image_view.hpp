@@ -32,6 +32,17 @@ struct ImageView {
   std::size_t row_stride() const { return stride != 0 ? stride : row_bytes(); }
 };
 
+// A rectangle of pixels, corners inclusive (u across, v down).
+struct PixelBox {
+  int u0 = 0, v0 = 0, u1 = -1, v1 = -1;
+  bool empty() const { return u1 < u0 || v1 < v0; }
+  bool contains(int u, int v) const { return u >= u0 && u <= u1 && v >= v0 && v <= v1; }
+  bool overlaps(const PixelBox& b) const {
+    return !empty() && !b.empty() && u0 <= b.u1 && b.u0 <= u1 && v0 <= b.v1 && b.v0 <= v1;
+  }
+  long area() const { return empty() ? 0 : static_cast<long>(u1 - u0 + 1) * (v1 - v0 + 1); }
+};
+
 // Checks a frame against the camera's size and the supported layouts; throws InputError at
 // `where` (the caller names the source: a log and its message, an image file) saying what is wrong.
 void check_image(const ImageView& image, int expected_width, int expected_height,

@@ -75,7 +75,14 @@ struct DetectionStats {
 
 struct LampDetections {
   std::vector<LampDetection> lamps;
-  DetectionStats stats;
+  DetectionStats stats;  // of the pixels read: the frame, or the windows
+  // Bright blobs cut by the image border that are not lamps (yet): a lamp entering the view
+  // before enough of it shows, or leaving it. Their bounding boxes, for a tracker to watch.
+  std::vector<PixelBox> border_blobs;
+  // detect_in only: a blob reached a window's edge inside the image, so it may be larger than
+  // the window showed; the lamps of the windows are then incomplete (read the whole frame).
+  bool spilled = false;
+  long pixels_read = 0;  // pixels thresholded: the frame's, or the windows'
 };
 
 class LampDetector {
@@ -91,6 +98,10 @@ class LampDetector {
   // colour and 16-bit frames are converted to 8-bit luminance. Not thread-safe: it reuses buffers.
   LampDetections detect(const ImageView& image);
   LampDetections detect(const Image8& image) { return detect(ImageView::of(image)); }
+  // The same, reading only the pixels of `windows` (overlapping ones are merged; each is clipped
+  // to the image). A blob wholly inside a window is measured exactly as detect() measures it:
+  // same component, same moments, completion from the same grey levels.
+  LampDetections detect_in(const ImageView& image, std::vector<PixelBox> windows);
 
   // Expected normalized area of a whole lamp at the nominal distance.
   double expected_area() const;
