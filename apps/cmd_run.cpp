@@ -13,10 +13,10 @@
 
 #include "commands.hpp"
 #include "lampnav/core/error.hpp"
+#include "lampnav/evaluation/replay.hpp"
+#include "lampnav/evaluation/report.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/internal/json_util.hpp"
-#include "lampnav/navigation/replay.hpp"
-#include "lampnav/navigation/report.hpp"
 #include "lampnav/navigation/runtime.hpp"
 #include "lampnav/sim/simulated_robot.hpp"
 
@@ -25,7 +25,7 @@ namespace lampnav::apps {
 namespace {
 
 namespace fs = std::filesystem;
-using navigation::Metrics;
+using evaluation::Metrics;
 
 std::string fixed(double v, int digits) {
   std::ostringstream s;
@@ -152,11 +152,11 @@ int run_mission(const RunArgs& a) {
   }
   // The recorded mission, replayed: the report's numbers, and the replay's speed.
   const io::MissionLog log = io::read_mission_log(log_path);
-  navigation::ReplayOptions ro;
+  evaluation::ReplayOptions ro;
   ro.initial_pose = s.start;
-  const navigation::ReplayResult r = navigation::replay(log, loaded.map, robot, ro);
-  navigation::write_replay(r, log, loaded.map, map_text, *log.robot_json, a.out);
-  navigation::write_report(r, log, loaded.map, "lampnav run: " + s.name, a.out);
+  const evaluation::ReplayResult r = evaluation::replay(log, loaded.map, robot, ro);
+  evaluation::write_replay(r, log, loaded.map, map_text, *log.robot_json, a.out);
+  evaluation::write_report(r, log, loaded.map, "lampnav run: " + s.name, a.out);
 
   const bool arrived = outcome.status == navigation::ExecutorStatus::arrived;
   std::vector<std::pair<std::string, std::string>> rows;
@@ -203,14 +203,14 @@ int run_replay(const ReplayArgs& a) {
     throw InputError({a.log, "attachments", "map.geojson"}, "the log has no map: give --map");
   }
   const graph::LoadedMap loaded = graph::parse_map(map_text, map_source);
-  navigation::ReplayOptions o;
+  evaluation::ReplayOptions o;
   o.use_ceiling = !a.no_ceiling;
   o.use_omni = !a.no_omni;
   o.initial_pose = initial;
   make_dir(a.out);
-  const navigation::ReplayResult r = navigation::replay(log, loaded.map, robot, o);
-  navigation::write_replay(r, log, loaded.map, map_text, robot_json, a.out);
-  navigation::write_report(r, log, loaded.map,
+  const evaluation::ReplayResult r = evaluation::replay(log, loaded.map, robot, o);
+  evaluation::write_replay(r, log, loaded.map, map_text, robot_json, a.out);
+  evaluation::write_report(r, log, loaded.map,
                            "lampnav replay: " + fs::path(a.log).filename().string(), a.out);
   for (const auto& n : r.notes) std::cerr << "lampnav: note: " << n << "\n";
   std::vector<std::pair<std::string, std::string>> rows;

@@ -11,9 +11,9 @@
 #include <fstream>
 #include <iterator>
 
+#include "lampnav/evaluation/replay.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/image_encoding.hpp"
-#include "lampnav/navigation/replay.hpp"
 #include "lampnav/sim/building.hpp"
 #include "lampnav/sim/scenario.hpp"
 
@@ -52,11 +52,11 @@ struct RecordedMission {
 
 void BM_ReplayOfficeMission(benchmark::State& state) {
   static const RecordedMission m;
-  navigation::ReplayOptions o;
+  evaluation::ReplayOptions o;
   o.initial_pose = m.start;
   double robot_s = 0, factor = 0;
   for (auto _ : state) {
-    const navigation::ReplayResult r = navigation::replay(m.log, m.map, m.robot, o);
+    const evaluation::ReplayResult r = evaluation::replay(m.log, m.map, m.robot, o);
     robot_s = r.metrics.duration_s;
     factor = r.metrics.realtime_factor;
     benchmark::DoNotOptimize(r.estimates.data());
@@ -77,11 +77,11 @@ void BM_OfficeMissionLog(benchmark::State& state) {
     e.jpeg_quality = static_cast<int>(state.range(0));
   }
   const RecordedMission m(e);
-  navigation::ReplayOptions o;
+  evaluation::ReplayOptions o;
   o.initial_pose = m.start;
-  navigation::ReplayResult r;
+  evaluation::ReplayResult r;
   for (auto _ : state) {
-    r = navigation::replay(m.log, m.map, m.robot, o);
+    r = evaluation::replay(m.log, m.map, m.robot, o);
     benchmark::DoNotOptimize(r.estimates.data());
   }
   state.counters["log_MB"] = static_cast<double>(m.bytes) / 1e6;
@@ -168,11 +168,11 @@ struct BuildingMission {
 
 void BM_ReplayBuildingMission(benchmark::State& state) {
   const BuildingMission m(static_cast<int>(state.range(0)));
-  navigation::ReplayOptions o;
+  evaluation::ReplayOptions o;
   o.initial_pose = m.start;
   double robot_s = 0, factor = 0, error = 0;
   for (auto _ : state) {
-    const navigation::ReplayResult r = navigation::replay(m.log, m.map, m.robot, o);
+    const evaluation::ReplayResult r = evaluation::replay(m.log, m.map, m.robot, o);
     robot_s = r.metrics.duration_s;
     factor = r.metrics.realtime_factor;
     error = r.metrics.position_error_m.mean;

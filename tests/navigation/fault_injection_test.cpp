@@ -9,14 +9,16 @@
 #include <fstream>
 #include <iterator>
 
+#include "lampnav/evaluation/replay.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
-#include "lampnav/navigation/replay.hpp"
 #include "lampnav/sim/scenario.hpp"
 #include "lampnav_test.hpp"
 
 namespace lampnav::navigation {
 namespace {
+
+using namespace lampnav::evaluation;  // replay, its results and outputs
 
 namespace fs = std::filesystem;
 

@@ -11,14 +11,16 @@
 #include <nlohmann/json.hpp>
 
 #include "lampnav/core/error.hpp"
+#include "lampnav/evaluation/replay.hpp"
 #include "lampnav/graph/geojson.hpp"
-#include "lampnav/navigation/replay.hpp"
 #include "lampnav/navigation/runtime.hpp"
 #include "lampnav/sim/simulated_robot.hpp"
 #include "lampnav_test.hpp"
 
 namespace lampnav::navigation {
 namespace {
+
+using namespace lampnav::evaluation;  // replay, its results and outputs
 
 namespace fs = std::filesystem;
 

@@ -13,9 +13,9 @@
 #include <sstream>
 #include <thread>
 
+#include "lampnav/evaluation/replay.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
-#include "lampnav/navigation/replay.hpp"
 #include "lampnav/sim/scenario.hpp"
 #include "lampnav_test.hpp"
 #include "ros_test_support.hpp"
@@ -35,7 +35,7 @@ TEST(Node, PublishesThePosesReplayComputesFromTheSameLog) {
   const std::string log_path = dir + "/corridor.mcap";
   sim::record_mission(sim::make_named_scenario("corridor", map, geojson, robot, 1), log_path);
   const io::MissionLog log = io::read_mission_log(log_path);
-  const navigation::ReplayResult replayed = navigation::replay(log, map, robot);
+  const evaluation::ReplayResult replayed = evaluation::replay(log, map, robot);
 
   const std::string domain = std::to_string(test::test_domain());
   const std::string node_cmd = std::string(LAMPNAV_BINARY) + " node --robot '" + robot_path +

@@ -16,7 +16,7 @@
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/navigation/runtime.hpp"
 
-namespace lampnav::navigation {
+namespace lampnav::evaluation {
 
 // A recorded mission behind the robot interface: its wheel readings and camera frames in the
 // order they became available (a frame after the wheel reading of the same instant).
@@ -47,7 +47,7 @@ class LogRobot : public Robot {
 };
 
 struct ReplayOptions {
-  RuntimeOptions runtime;
+  navigation::RuntimeOptions runtime;
   bool use_ceiling = true, use_omni = true;
   std::optional<Pose2> initial_pose;  // without it the omni camera finds the robot first
 };
@@ -91,19 +91,20 @@ struct Metrics {
   int kidnaps = 0, recoveries = 0;
   ErrorStats relocalization_latency_s;  // from each kidnap to the fix that follows it
   std::size_t lamps_seen = 0, lamps_labelled = 0;
-  InputFaultCounts input_faults[3];  // by InputStream: gaps, duplicates, out of order
+  navigation::InputFaultCounts
+      input_faults[3];               // by navigation::InputStream: gaps, duplicates, out of order
   std::uint64_t frames_too_old = 0;  // captured before the filter's history
   double runtime_s = 0, realtime_factor = 0;
 };
 
 struct ReplayResult {
-  std::vector<EstimateSample> estimates;          // one per wheel reading, once a pose is known
-  std::vector<HypothesesSample> hypotheses;       // whenever they change
-  std::vector<std::pair<Stamp, Pose2>> odometry;  // wheels alone, from the first pose
-  std::vector<LampFrame> lamp_frames;             // ceiling frames with their detections
-  std::vector<fusion::LocalizerEvent> events;     // the localizer's mode changes
-  std::vector<InputFault> input_faults;           // as they came
-  RunOutcome outcome;
+  std::vector<EstimateSample> estimates;             // one per wheel reading, once a pose is known
+  std::vector<HypothesesSample> hypotheses;          // whenever they change
+  std::vector<std::pair<Stamp, Pose2>> odometry;     // wheels alone, from the first pose
+  std::vector<LampFrame> lamp_frames;                // ceiling frames with their detections
+  std::vector<fusion::LocalizerEvent> events;        // the localizer's mode changes
+  std::vector<navigation::InputFault> input_faults;  // as they came
+  navigation::RunOutcome outcome;
   Metrics metrics;
   std::vector<std::string> notes;  // what was used, what was missing, what was cut short
 };
@@ -126,4 +127,4 @@ std::string metrics_json(const Metrics& metrics);
 // TUM trajectory lines: "t x y z qx qy qz qw", t in seconds.
 std::string tum(const std::vector<std::pair<Stamp, Pose2>>& poses);
 
-}  // namespace lampnav::navigation
+}  // namespace lampnav::evaluation

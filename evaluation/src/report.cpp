@@ -1,4 +1,4 @@
-#include "lampnav/navigation/report.hpp"
+#include "lampnav/evaluation/report.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +11,7 @@
 #include "lampnav/fusion/ekf.hpp"
 #include "lampnav/internal/json_util.hpp"
 
-namespace lampnav::navigation {
+namespace lampnav::evaluation {
 
 namespace {
 
@@ -449,4 +449,4 @@ void write_report(const ReplayResult& r, const io::MissionLog& log,
   for (const auto& f : figures) json::write_file(dir + "/" + f.file, f.svg);
 }
 
-}  // namespace lampnav::navigation
+}  // namespace lampnav::evaluation

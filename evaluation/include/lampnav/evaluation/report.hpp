@@ -7,11 +7,11 @@
 #include <string>
 #include <vector>
 
+#include "lampnav/evaluation/replay.hpp"
 #include "lampnav/graph/map.hpp"
 #include "lampnav/io/mission_log.hpp"
-#include "lampnav/navigation/replay.hpp"
 
-namespace lampnav::navigation {
+namespace lampnav::evaluation {
 
 struct Figure {
   std::string file;  // e.g. "map.svg"
@@ -30,4 +30,4 @@ void write_report(const ReplayResult& result, const io::MissionLog& log,
                   const graph::TopologicalMap& map, const std::string& title,
                   const std::string& dir);
 
-}  // namespace lampnav::navigation
+}  // namespace lampnav::evaluation

@@ -1,4 +1,4 @@
-#include "lampnav/navigation/replay.hpp"
+#include "lampnav/evaluation/replay.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -13,7 +13,7 @@
 #include "lampnav/fusion/ekf.hpp"
 #include "lampnav/internal/json_util.hpp"
 
-namespace lampnav::navigation {
+namespace lampnav::evaluation {
 
 namespace {
 
@@ -74,7 +74,7 @@ std::optional<RobotInput> LogRobot::next() {
 namespace {
 
 // Collects what the loop saw.
-struct Recorder : RuntimeObserver {
+struct Recorder : navigation::RuntimeObserver {
   ReplayResult* r;
   void on_estimate(const fusion::LocalizerEstimate& e) override {
     r->estimates.push_back({e.stamp, e.pose, e.covariance, e.mode, e.node ? e.node->name : ""});
@@ -86,7 +86,7 @@ struct Recorder : RuntimeObserver {
         (!e.hypotheses.empty() && last->hypotheses.front().weight != e.hypotheses.front().weight);
     if (changed) r->hypotheses.push_back({e.stamp, e.mode, e.hypotheses});
   }
-  void on_input_fault(const InputFault& f) override { r->input_faults.push_back(f); }
+  void on_input_fault(const navigation::InputFault& f) override { r->input_faults.push_back(f); }
   void on_ceiling(const FrameInput& f, const fusion::CeilingObservation& ob) override {
     LampFrame lf;
     lf.arrival = f.arrival;
@@ -144,10 +144,10 @@ std::string one_decimal(double v) {
 void note_input_faults(ReplayResult& r, const fusion::LocalizerCounts& c) {
   constexpr std::size_t kShown = 3;
   for (int s = 0; s < 3; ++s) {
-    const InputFaultCounts& n = r.outcome.faults[s];
+    const navigation::InputFaultCounts& n = r.outcome.faults[s];
     r.metrics.input_faults[s] = n;
     if (n.total() == 0) continue;
-    std::string line = std::string(to_string(static_cast<InputStream>(s))) + ": " +
+    std::string line = std::string(to_string(static_cast<navigation::InputStream>(s))) + ": " +
                        std::to_string(n.gaps) + " gaps (longest " + one_decimal(n.longest_gap_s) +
                        " s), " + std::to_string(n.duplicates) + " duplicates, " +
                        std::to_string(n.out_of_order) + " out of order";
@@ -277,7 +277,7 @@ ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
     r.notes.push_back(std::to_string(log.skipped_messages) + " damaged messages skipped");
 
   LogRobot robot_in(log, ceiling, omni);
-  Runtime rt(map, robot, options.runtime);
+  navigation::Runtime rt(map, robot, options.runtime);
   Recorder rec;
   rec.r = &r;
   const auto t0 = std::chrono::steady_clock::now();
@@ -397,7 +397,7 @@ std::string metrics_json(const Metrics& m) {
   j["lamps_labelled"] = m.lamps_labelled;
   Json faults;
   for (int s = 0; s < 3; ++s) {
-    const InputFaultCounts& f = m.input_faults[s];
+    const navigation::InputFaultCounts& f = m.input_faults[s];
     faults[s == 0   ? "wheels"
            : s == 1 ? "ceiling"
                     : "omni"] = {{"gaps", f.gaps},
@@ -472,4 +472,4 @@ void write_replay(const ReplayResult& r, const io::MissionLog& log,
   json::write_file(dir + "/metrics.json", metrics_json(r.metrics));
 }
 
-}  // namespace lampnav::navigation
+}  // namespace lampnav::evaluation
