@@ -4,11 +4,11 @@
 #include <queue>
 #include <random>
 
+#include "joystick.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/graph/planner.hpp"
 #include "lampnav/graph/route_commands.hpp"
 #include "lampnav/io/mission_log.hpp"
-#include "lampnav/navigation/path_follower.hpp"
 #include "world.hpp"
 
 namespace lampnav::sim {
@@ -209,7 +209,9 @@ RecordStats record_mission(const Scenario& s, const std::string& path,
     }
     world.stats().arrived = true;
   } else {
-    navigation::PathFollower follower(s.waypoints, {s.max_speed, 0.8, 0.6, 0.1});
+    JoystickOptions joystick;
+    joystick.max_speed = s.max_speed;
+    Joystick follower(s.waypoints, joystick);
     const double expected = path_length(s.waypoints) / s.max_speed;
     std::size_t kidnap_index = 0;
     while (!follower.arrived() &&
@@ -227,9 +229,9 @@ RecordStats record_mission(const Scenario& s, const std::string& path,
           }
         }
         if (pts.size() < 2) pts.push_back(s.waypoints.back());
-        follower = navigation::PathFollower(pts, {s.max_speed, 0.8, 0.6, 0.1});
+        follower = Joystick(pts, joystick);
       }
-      const auto [v, w] = follower.command(world.pose());
+      const auto [v, w] = follower.steer(world.pose());
       world.drive(v, w);
       world.deliver(world.now_ns());
       if (progress && (world.now_ns() / world.period_ns()) % 50 == 0)
