@@ -123,10 +123,11 @@ Drive hard_drive(const World& w, const CameraDescription& camera) {
     auto lamps = w.map.lamps_within(pose.translation(), 5.0);
     if (failed_off && !lamps.empty()) {
       // The lamp nearest the robot is out.
-      const auto nearest = std::min_element(lamps.begin(), lamps.end(), [&](const graph::Lamp* a, const graph::Lamp* b) {
-        return (Vector2d(a->xyz.x(), a->xyz.y()) - pose.translation()).norm() <
-               (Vector2d(b->xyz.x(), b->xyz.y()) - pose.translation()).norm();
-      });
+      const auto nearest = std::min_element(
+          lamps.begin(), lamps.end(), [&](const graph::Lamp* a, const graph::Lamp* b) {
+            return (Vector2d(a->xyz.x(), a->xyz.y()) - pose.translation()).norm() <
+                   (Vector2d(b->xyz.x(), b->xyz.y()) - pose.translation()).norm();
+          });
       lamps.erase(nearest);
     }
     d.frames.push_back(renderer.render(pose, {bump(rng), bump(rng)}, lamps, rng));
@@ -207,8 +208,8 @@ void expect_windows_match_whole_frames(const CameraDescription& camera) {
   EXPECT_LT(static_cast<double>(pixels) / (drive.frames.size() * camera.width * camera.height),
             0.5);
   std::cout << drive.frames.size() << " frames, " << windowed_frames << " windowed, "
-            << 100.0 * pixels / (static_cast<double>(drive.frames.size()) * camera.width *
-                                 camera.height)
+            << 100.0 * pixels /
+                   (static_cast<double>(drive.frames.size()) * camera.width * camera.height)
             << " % of the pixels read, " << late << " frames late for the relit lamp\n";
 }
 

@@ -259,14 +259,15 @@ LampDetections LampDetector::Impl::detect(const ImageView& image) {
   return out;
 }
 
-LampDetections LampDetector::Impl::detect_in(const ImageView& image, std::vector<PixelBox> windows) {
+LampDetections LampDetector::Impl::detect_in(const ImageView& image,
+                                             std::vector<PixelBox> windows) {
   check_image(image, w, h, {"", "image", ""});
   const ImageView g = grey_view(image, grey);
-  for (auto& b : windows) b = {std::max(b.u0, 0), std::max(b.v0, 0), std::min(b.u1, w - 1),
-                               std::min(b.v1, h - 1)};
-  windows.erase(std::remove_if(windows.begin(), windows.end(),
-                               [](const PixelBox& b) { return b.empty(); }),
-                windows.end());
+  for (auto& b : windows)
+    b = {std::max(b.u0, 0), std::max(b.v0, 0), std::min(b.u1, w - 1), std::min(b.v1, h - 1)};
+  windows.erase(
+      std::remove_if(windows.begin(), windows.end(), [](const PixelBox& b) { return b.empty(); }),
+      windows.end());
   // Overlapping windows become their bounding box, until none overlap: a blob is then read once.
   for (bool merged = true; merged;) {
     merged = false;
@@ -315,7 +316,8 @@ bool LampDetector::Impl::measure_blobs(const ImageView& g, const PixelBox& box,
       if (measure(c, g, d, out.stats)) out.lamps.push_back(d);
     }
     const bool at_border = c.u0 == 0 || c.v0 == 0 || c.u1 == w - 1 || c.v1 == h - 1;
-    if (at_border && out.lamps.size() == before) out.border_blobs.push_back({c.u0, c.v0, c.u1, c.v1});
+    if (at_border && out.lamps.size() == before)
+      out.border_blobs.push_back({c.u0, c.v0, c.u1, c.v1});
   }
   return true;
 }

@@ -27,18 +27,16 @@ namespace {
 struct Track {
   int id = 0;
   int age = 0;
-  LampDetection last;             // its lamp in the last frame
-  Vector2d velocity{0, 0};        // px a frame, of the lamp's centre
-  double unsure = 0;              // px: the last change of velocity (the prediction's error)
-  bool moving_known = false;      // velocity measured (two whole views of the lamp)
+  LampDetection last;         // its lamp in the last frame
+  Vector2d velocity{0, 0};    // px a frame, of the lamp's centre
+  double unsure = 0;          // px: the last change of velocity (the prediction's error)
+  bool moving_known = false;  // velocity measured (two whole views of the lamp)
   Vector2d predicted() const { return last.centre_px + velocity; }
 };
 
 bool whole_view(const LampDetection& d) { return d.view != LampView::partial; }
 
-PixelBox grown(const PixelBox& b, int by) {
-  return {b.u0 - by, b.v0 - by, b.u1 + by, b.v1 + by};
-}
+PixelBox grown(const PixelBox& b, int by) { return {b.u0 - by, b.v0 - by, b.u1 + by, b.v1 + by}; }
 
 PixelBox as_box(const std::array<int, 4>& b) { return {b[0], b[1], b[2], b[3]}; }
 
@@ -48,8 +46,8 @@ struct LampTracker::Impl {
   LampDetector detector;
   LampTrackerOptions o;
   std::uint8_t threshold;
-  std::vector<Track> tracks;      // oldest first
-  std::vector<PixelBox> watched;  // border blobs of the last frame that were not lamps
+  std::vector<Track> tracks;       // oldest first
+  std::vector<PixelBox> watched;   // border blobs of the last frame that were not lamps
   std::vector<int> pending_ended;  // from reset()
   int next_id = 1;
   int since_whole = 1 << 20;  // frames since the last frame read whole; huge: read the next whole
@@ -90,10 +88,10 @@ std::optional<std::vector<PixelBox>> LampTracker::Impl::windows() const {
   std::vector<PixelBox> boxes;
   for (const Track& t : tracks) {
     const Vector2d v = t.moving_known ? t.velocity : mean;
-    const int margin = o.window_margin_px + static_cast<int>(std::ceil(
-                                               t.moving_known ? t.unsure
-                                               : known > 0    ? 2 * o.window_margin_px
-                                                              : o.max_step_px));
+    const int margin =
+        o.window_margin_px + static_cast<int>(std::ceil(t.moving_known ? t.unsure
+                                                        : known > 0    ? 2 * o.window_margin_px
+                                                                       : o.max_step_px));
     // Where the lamp was and where it goes: a lamp cut by the border shrinks or grows there.
     const PixelBox b = as_box(t.last.bbox);
     const int du = static_cast<int>(std::lround(v.x())), dv = static_cast<int>(std::lround(v.y()));
@@ -101,14 +99,14 @@ std::optional<std::vector<PixelBox>> LampTracker::Impl::windows() const {
                            std::max(b.u1, b.u1 + du), std::max(b.v1, b.v1 + dv)},
                           margin));
   }
-  const int step = o.window_margin_px +
-                   static_cast<int>(std::ceil(known > 0 ? fastest : o.max_step_px));
+  const int step =
+      o.window_margin_px + static_cast<int>(std::ceil(known > 0 ? fastest : o.max_step_px));
   for (const PixelBox& b : watched) boxes.push_back(grown(b, step));
   return boxes;
 }
 
-bool LampTracker::Impl::ring_unexplained(const ImageView& g, const std::vector<PixelBox>& boxes)
-    const {
+bool LampTracker::Impl::ring_unexplained(const ImageView& g,
+                                         const std::vector<PixelBox>& boxes) const {
   const int w = g.width, h = g.height;
   auto bright = [&](int u, int v) {
     return g.data[static_cast<std::size_t>(v) * g.row_stride() + u] >= threshold;
