@@ -53,4 +53,9 @@ std::ostream& operator<<(std::ostream& os, const Pose2& p) {
   return os << "(" << p.x() << ", " << p.y() << ", " << p.yaw() << ")";
 }
 
+Pose2 interpolate(const Pose2& a, const Pose2& b, double f) {
+  return Pose2(a.translation() + f * (b.translation() - a.translation()),
+               wrap_angle(a.yaw() + f * wrap_angle(b.yaw() - a.yaw())));
+}
+
 }  // namespace lampnav

@@ -288,7 +288,7 @@ ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
   note_input_faults(r, rt.localizer().counts());
   const auto& ev = rt.localizer().events();
   for (const auto& e : ev)
-    if (e.reason != "initialized") r.events.push_back(e);
+    if (e.cause != fusion::ModeCause::initialized) r.events.push_back(e);
   // Wheels alone, from the first pose the stack had.
   const auto known =
       std::find_if(r.estimates.begin(), r.estimates.end(),

@@ -161,7 +161,31 @@ void KidnapMonitor::reset() {
   omni_bad_ = 0;
 }
 
-std::optional<std::string> KidnapMonitor::ceiling(const CeilingEvidence& e) {
+const char* to_string(ModeCause cause) {
+  switch (cause) {
+    case ModeCause::ceiling_contradicts:
+      return "ceiling_contradicts";
+    case ModeCause::innovations_do_not_fit:
+      return "innovations_do_not_fit";
+    case ModeCause::omni_disagrees:
+      return "omni_disagrees";
+    case ModeCause::omni_locates_elsewhere:
+      return "omni_locates_elsewhere";
+    case ModeCause::odometry_gap:
+      return "odometry_gap";
+    case ModeCause::hypotheses_undecided:
+      return "hypotheses_undecided";
+    case ModeCause::initialized:
+      return "initialized";
+    case ModeCause::global_fix:
+      return "global_fix";
+    case ModeCause::confirmed:
+      return "confirmed";
+  }
+  return "?";
+}
+
+std::optional<LossVerdict> KidnapMonitor::ceiling(const CeilingEvidence& e) {
   ++counts_.frames;
   counts_.unexplained_lamps += e.unexplained;
   counts_.missing_lamps += e.expected_missing;
@@ -184,10 +208,10 @@ std::optional<std::string> KidnapMonitor::ceiling(const CeilingEvidence& e) {
   if (missing > 0) why += ", " + std::to_string(missing) + " frames missing predicted lamps";
   why += ")";
   reset();
-  return why;
+  return LossVerdict{ModeCause::ceiling_contradicts, why};
 }
 
-std::optional<std::string> KidnapMonitor::innovation(double d2) {
+std::optional<LossVerdict> KidnapMonitor::innovation(double d2) {
   if (!std::isfinite(d2)) d2 = 1e9;
   nis_.push_back(d2);
   nis_sum_ += d2;
@@ -202,10 +226,10 @@ std::optional<std::string> KidnapMonitor::innovation(double d2) {
                           " measurements do not fit (NIS sum " + std::to_string(nis_sum_) + " > " +
                           std::to_string(nis_limit_) + ")";
   reset();
-  return why;
+  return LossVerdict{ModeCause::innovations_do_not_fit, why};
 }
 
-std::optional<std::string> KidnapMonitor::omni(const OmniCheckResult& r) {
+std::optional<LossVerdict> KidnapMonitor::omni(const OmniCheckResult& r) {
   if (!r.conclusive) return std::nullopt;
   ++counts_.omni_checks;
   if (r.consistent) {
@@ -224,7 +248,7 @@ std::optional<std::string> KidnapMonitor::omni(const OmniCheckResult& r) {
                           " predicted lamps seen, " + std::to_string(omni_bad_) +
                           " checks in a row)";
   reset();
-  return why;
+  return LossVerdict{ModeCause::omni_disagrees, why};
 }
 
 }  // namespace lampnav::fusion

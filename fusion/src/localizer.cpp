@@ -111,11 +111,11 @@ struct Localizer::Impl {
   }
   bool unsure() const { return !is_certain(mode); }
 
-  void set_mode(LocalizerMode m, const std::string& why) {
+  void set_mode(LocalizerMode m, ModeCause cause, const std::string& why) {
     if (m == mode) return;
     const bool was_unsure = unsure();
     mode = m;
-    events.push_back({now(), m, why});
+    events.push_back({now(), m, cause, why});
     if (unsure() && !was_unsure) {
       if (pipeline) pipeline->reset();  // its labels are worthless
       calibration.forget_measurements();
@@ -158,9 +158,9 @@ struct Localizer::Impl {
     if (relocalization.verdict == HypothesisVerdict::ambiguous ||
         relocalization.verdict == HypothesisVerdict::symmetric) {
       ++counts.ambiguous_frames;
-      set_mode(LocalizerMode::ambiguous, relocalization.why);
+      set_mode(LocalizerMode::ambiguous, ModeCause::hypotheses_undecided, relocalization.why);
     } else {
-      set_mode(LocalizerMode::lost, relocalization.why);
+      set_mode(LocalizerMode::lost, ModeCause::hypotheses_undecided, relocalization.why);
     }
   }
 
@@ -175,7 +175,7 @@ struct Localizer::Impl {
   // An omni check disagreed with the estimate once: does the frame itself put the robot
   // elsewhere, far more likely than where the estimate is? Both poses are scored alike (the
   // estimate's uncertainty for both), so the ratio compares the places, not their refinement.
-  std::optional<std::string> second_opinion(const FilterState& prior, const OmniCheckResult& r) {
+  std::optional<LossVerdict> second_opinion(const FilterState& prior, const OmniCheckResult& r) {
     if (o.second_opinion_ratio <= 0) return std::nullopt;
     const GlobalLocalization g = global->locate(last_omni);
     if (!g.found() || g.ambiguous) return std::nullopt;
@@ -194,7 +194,7 @@ struct Localizer::Impl {
                   "the omnidirectional view does not match the estimate (%d of %d predicted lamps "
                   "seen) and puts the robot %.1f m away, e^%.0f times likelier",
                   r.matched, r.expected, away, log_ratio);
-    return std::string(why);
+    return LossVerdict{ModeCause::omni_locates_elsewhere, why};
   }
 
   // While tracking: the omni frame's lamps, matched near the estimate, as a pose measurement.
@@ -231,20 +231,20 @@ struct Localizer::Impl {
     odometry = OdometryTrack(o.ekf.semi_axis);
     ++counts.odometry_gaps;
     if (unsure())
-      set_mode(LocalizerMode::lost, why);
+      set_mode(LocalizerMode::lost, ModeCause::odometry_gap, why);
     else
-      lose(std::string(why), false);
+      lose(LossVerdict{ModeCause::odometry_gap, why}, false);
   }
 
   // `keep_estimate`: the estimate tracked until now stays one of the places the robot may be (a
   // false alarm then costs a few frames, never the pose); not when the motion since it is unknown
   // (odometry that stopped), where it would only be a likely-looking guess.
-  void lose(const std::optional<std::string>& why, bool keep_estimate = true) {
-    if (!why || unsure()) return;
+  void lose(const std::optional<LossVerdict>& loss, bool keep_estimate = true) {
+    if (!loss || unsure()) return;
     if (keep_estimate && ekf.initialized())
       hypotheses->keep(ekf.stamp(), ekf.pose(), ekf.covariance(), odometry);
     refresh_status();  // not the last loss's verdict
-    set_mode(LocalizerMode::lost, *why);
+    set_mode(LocalizerMode::lost, loss->cause, loss->why);
   }
 
   void observe(const CeilingObservation& ob, const FilterState& prior) {
@@ -277,7 +277,7 @@ struct Localizer::Impl {
           calibration.heading(ob.measurement->stamp, ob.measurement->pose.yaw(),
                               ob.measurement->covariance(2, 2));
         if (mode == LocalizerMode::relocalized && r.applied())
-          set_mode(LocalizerMode::tracking,
+          set_mode(LocalizerMode::tracking, ModeCause::confirmed,
                    "a ceiling measurement agrees with the relocalized pose");
       } else {
         ++counts.measurements_refused;
@@ -348,7 +348,7 @@ void Localizer::initialize(Stamp stamp, const Pose2& pose, const Eigen::Matrix3d
   if (m.pipeline) m.pipeline->reset();
   m.hypotheses->clear();
   m.mode = LocalizerMode::tracking;
-  m.events.push_back({stamp, LocalizerMode::tracking, "initialized"});
+  m.events.push_back({stamp, LocalizerMode::tracking, ModeCause::initialized, "initialized"});
 }
 
 bool Localizer::initialized() const { return impl_->ekf.initialized(); }
@@ -429,9 +429,9 @@ void Localizer::omni_detection(Stamp stamp, const vision::OmniDetection& detecti
   m.last_omni_check = stamp;
   const OmniCheckResult r = m.omni_check->check(prior->pose(), prior->P, m.last_omni.blobs);
   if (m.mode == LocalizerMode::relocalized && r.conclusive && r.consistent)
-    m.set_mode(LocalizerMode::tracking,
+    m.set_mode(LocalizerMode::tracking, ModeCause::confirmed,
                "the omnidirectional view agrees with the relocalized pose");
-  std::optional<std::string> loss = m.monitor.omni(r);
+  std::optional<LossVerdict> loss = m.monitor.omni(r);
   if (!loss && r.conclusive && !r.consistent) {
     loss = m.second_opinion(*prior, r);
     if (loss) m.monitor.reset();
@@ -469,7 +469,7 @@ bool Localizer::global_fix(const GlobalFix& fix) {
   if (m.pipeline) m.pipeline->reset();
   m.calibration.forget_measurements();
   m.hypotheses->clear();
-  m.set_mode(LocalizerMode::relocalized,
+  m.set_mode(LocalizerMode::relocalized, ModeCause::global_fix,
              "global fix" + (fix.source.empty() ? std::string() : " from " + fix.source));
   return true;
 }

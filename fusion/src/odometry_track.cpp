@@ -7,11 +7,6 @@
 
 namespace lampnav::fusion {
 
-Pose2 interpolate(const Pose2& a, const Pose2& b, double f) {
-  return Pose2(a.translation() + f * (b.translation() - a.translation()),
-               wrap_angle(a.yaw() + f * wrap_angle(b.yaw() - a.yaw())));
-}
-
 OdometryTrack::OdometryTrack(double semi_axis, Duration kept)
     : semi_axis_(semi_axis), kept_(kept) {}
 

@@ -84,7 +84,6 @@ std::string base64_decode(const std::string& text) {
   return out;
 }
 
-
 // ---------------------------------------------------------------------------------------------
 // Writer.
 
@@ -542,8 +541,7 @@ Pose2 TruthTrack::at(Stamp t) const {
   const auto& a = std::prev(it)->value;
   if ((b.pose.translation() - a.pose.translation()).norm() > 0.5) return a.pose;
   const double f = to_seconds(t - a.stamp) / std::max(1e-12, to_seconds(b.stamp - a.stamp));
-  return Pose2(a.pose.translation() + f * (b.pose.translation() - a.pose.translation()),
-               wrap_angle(a.pose.yaw() + f * wrap_angle(b.pose.yaw() - a.pose.yaw())));
+  return interpolate(a.pose, b.pose, f);
 }
 
 }  // namespace lampnav::io

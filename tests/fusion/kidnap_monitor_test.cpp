@@ -29,9 +29,10 @@ TEST(KidnapMonitor, LostAfterEnoughContradictingFramesInTheWindow) {
   ASSERT_FALSE(m.ceiling(frame(1)));
   ASSERT_FALSE(m.ceiling(frame(1)));
   ASSERT_FALSE(m.ceiling(frame(1)));
-  const auto why = m.ceiling(frame(1));
-  ASSERT_TRUE(why);
-  EXPECT_NE(why->find("contradict"), std::string::npos);
+  const auto loss = m.ceiling(frame(1));
+  ASSERT_TRUE(loss);
+  EXPECT_EQ(loss->cause, ModeCause::ceiling_contradicts);
+  EXPECT_NE(loss->why.find("contradict"), std::string::npos);
   EXPECT_EQ(m.counts().losses, 1u);
   // The window was reset: the next frame alone says nothing.
   EXPECT_FALSE(m.ceiling(frame(1)));
@@ -43,7 +44,10 @@ TEST(KidnapMonitor, MissingLampsAloneNeverLoseButSupportContradictions) {
   m.reset();
   for (int i = 0; i < 4; ++i) ASSERT_FALSE(m.ceiling(frame(0, 1, 0)));
   ASSERT_FALSE(m.ceiling(frame(1, 0, 0)));
-  EXPECT_TRUE(m.ceiling(frame(1, 0, 0)));  // 2 contradictions + 4 dark-where-lamps-should-be
+  const auto loss = m.ceiling(frame(1, 0, 0));  // 2 contradictions + 4 dark-where-lamps-should-be
+  ASSERT_TRUE(loss);
+  EXPECT_EQ(loss->cause, ModeCause::ceiling_contradicts);
+  EXPECT_NE(loss->why.find("contradict the map"), std::string::npos) << loss->why;
 }
 
 TEST(KidnapMonitor, NormalisedInnovationWindow) {
@@ -54,7 +58,9 @@ TEST(KidnapMonitor, NormalisedInnovationWindow) {
   for (int i = 0; i < 5000; ++i) ASSERT_FALSE(m.innovation(nis(rng))) << i;  // a consistent filter
   for (int i = 0; i < 7; ++i) ASSERT_FALSE(m.innovation(limit / 8 * 0.9));
   // One wild innovation is enough once the window's sum passes the quantile.
-  EXPECT_TRUE(m.innovation(limit));
+  const auto loss = m.innovation(limit);
+  ASSERT_TRUE(loss);
+  EXPECT_EQ(loss->cause, ModeCause::innovations_do_not_fit);
   EXPECT_EQ(m.counts().nis_alarms, 1u);
 }
 
@@ -73,7 +79,10 @@ TEST(KidnapMonitor, OmniChecksInARowOrOneBeyondDoubt) {
   EXPECT_FALSE(m.omni(weak));
   EXPECT_FALSE(m.omni(fine));  // a consistent check breaks the run
   EXPECT_FALSE(m.omni(weak));
-  EXPECT_TRUE(m.omni(weak));
+  const auto loss = m.omni(weak);
+  ASSERT_TRUE(loss);
+  EXPECT_EQ(loss->cause, ModeCause::omni_disagrees);
+  EXPECT_STREQ(to_string(loss->cause), "omni_disagrees");
   OmniCheckResult strong = weak;
   strong.blob_side = true;
   strong.blobs = 12;

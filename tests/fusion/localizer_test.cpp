@@ -159,6 +159,15 @@ Outcome replay(const sim::Scenario& s, const io::MissionLog& log, const graph::T
     // New mode changes: a loss is the detection of the latest kidnap, or a false alarm.
     for (; events_seen < loc.events().size(); ++events_seen) {
       const LocalizerEvent& ev = loc.events()[events_seen];
+      // The cause agrees with the mode: fixes relocalize, evidence loses, a start initializes.
+      if (ev.mode == LocalizerMode::relocalized) {
+        EXPECT_EQ(ev.cause, ModeCause::global_fix);
+      }
+      if (ev.mode == LocalizerMode::lost) {
+        EXPECT_NE(ev.cause, ModeCause::global_fix);
+        EXPECT_NE(ev.cause, ModeCause::confirmed);
+        EXPECT_NE(ev.cause, ModeCause::initialized);
+      }
       if (ev.mode == LocalizerMode::relocalized) {
         // The omni relocalizer's fix, scored against the truth when it is made.
         const LocalizerEstimate e = loc.estimate();

@@ -5,6 +5,7 @@
 // notes); the estimate recovers or says lost, never a wrong fix; nothing that arrived whole is
 // dropped; no exception escapes.
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -112,6 +113,22 @@ TEST(FaultInjection, OdometryStopsFor10Seconds) {
   std::cout << notes(r);
   EXPECT_EQ(r.metrics.input_faults[0].gaps, 1u);
   EXPECT_NEAR(r.metrics.input_faults[0].longest_gap_s, 10.0, 0.1);
+  // The localizer lets go of the pose and says why, as a cause a program can act on: the ceiling
+  // frames of the gap contradict a robot that seems to stand still, or the gap itself. Then a
+  // global fix, and a measurement that confirms it.
+  std::vector<fusion::ModeCause> causes;
+  for (const auto& e : r.events) {
+    std::cout << to_seconds(e.stamp) << " s: " << fusion::to_string(e.cause) << ", " << e.reason
+              << "\n";
+    causes.push_back(e.cause);
+  }
+  ASSERT_GE(r.events.size(), 2u);
+  EXPECT_EQ(r.events.front().mode, fusion::LocalizerMode::lost);
+  EXPECT_TRUE(causes.front() == fusion::ModeCause::ceiling_contradicts ||
+              causes.front() == fusion::ModeCause::odometry_gap)
+      << fusion::to_string(causes.front());
+  EXPECT_GE(to_seconds(r.events.front().stamp), 29.5);
+  EXPECT_EQ(causes[1], fusion::ModeCause::global_fix);
 
   EXPECT_EQ(r.metrics.wrong_fixes, 0);
   EXPECT_EQ(r.outcome.wheel_readings, log.wheels.size());

@@ -42,6 +42,10 @@ class Pose2 {
   double yaw_ = 0.0;
 };
 
+// Linear interpolation between two poses, the yaw along the shorter arc: f = 0 gives a, 1 gives b.
+// The one interpolation of poses (dead reckoning between readings, the truth between samples).
+Pose2 interpolate(const Pose2& a, const Pose2& b, double f);
+
 std::ostream& operator<<(std::ostream& os, const Pose2& p);
 
 }  // namespace lampnav

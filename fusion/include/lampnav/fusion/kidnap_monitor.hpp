@@ -23,6 +23,29 @@
 
 namespace lampnav::fusion {
 
+// Why the localizer's mode changed, for programs to act on; the event's text says the same to a
+// person. The kidnap monitor gives the first three, the localizer the rest.
+enum class ModeCause {
+  ceiling_contradicts,     // ceiling frames contradict the map (lamps where it has none, or none
+                           // where it has them)
+  innovations_do_not_fit,  // the measurements' NIS over a window exceeds its chi-square bound
+  omni_disagrees,          // omni checks in a row do not match the estimate
+  omni_locates_elsewhere,  // one omni check disagrees and the frame locates the robot far away,
+                           // far likelier (the second opinion)
+  odometry_gap,            // no wheel odometry for too long: the motion in between is unknown
+  hypotheses_undecided,    // lost or ambiguous: the hypotheses do not settle it yet
+  initialized,             // a start pose was given
+  global_fix,              // relocalized: one hypothesis holds, or a fix from outside
+  confirmed,               // a measurement agrees with the relocalized pose: tracking again
+};
+const char* to_string(ModeCause cause);
+
+// A loss the evidence shows: its cause, and the same in words.
+struct LossVerdict {
+  ModeCause cause = ModeCause::ceiling_contradicts;
+  std::string why;
+};
+
 struct KidnapMonitorOptions {
   int window_frames = 10;             // ceiling frames in the sliding window (1 s at 10 Hz)
   int contradicting_frames = 4;       // frames with a contradiction in the window that mean lost
@@ -97,9 +120,9 @@ class KidnapMonitor {
  public:
   explicit KidnapMonitor(const KidnapMonitorOptions& options = {});
   // Each returns why the robot is lost, once the evidence says so.
-  std::optional<std::string> ceiling(const CeilingEvidence& evidence);
-  std::optional<std::string> innovation(double mahalanobis2);
-  std::optional<std::string> omni(const OmniCheckResult& result);
+  std::optional<LossVerdict> ceiling(const CeilingEvidence& evidence);
+  std::optional<LossVerdict> innovation(double mahalanobis2);
+  std::optional<LossVerdict> omni(const OmniCheckResult& result);
   // Forgets the evidence (after relocalization).
   void reset();
 

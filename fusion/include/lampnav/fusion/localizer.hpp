@@ -104,7 +104,8 @@ struct LocalizerEstimate {
 struct LocalizerEvent {
   Stamp stamp;  // when it happened (arrival time of the evidence)
   LocalizerMode mode;
-  std::string reason;
+  ModeCause cause;     // what programs act on
+  std::string reason;  // the same for a person, with the evidence's figures
 };
 
 // Inputs the localizer did not use, by reason (besides the EKF's own refusals).

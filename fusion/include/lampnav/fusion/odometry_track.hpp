@@ -37,7 +37,4 @@ class OdometryTrack {
   std::deque<double> distance_;  // cumulative travel at each pose
 };
 
-// Linear interpolation between two poses (the yaw along the shorter arc): f = 0 gives a.
-Pose2 interpolate(const Pose2& a, const Pose2& b, double f);
-
 }  // namespace lampnav::fusion
