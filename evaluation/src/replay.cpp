@@ -182,7 +182,7 @@ void score(ReplayResult& r, const io::MissionLog& log) {
   // Kidnaps and the fixes after them.
   std::vector<Stamp> kidnaps, fixes;
   for (const auto& e : log.events)
-    if (e.value.kind == "kidnap") kidnaps.push_back(e.value.stamp);
+    if (e.value.type() == io::EventKind::kidnap) kidnaps.push_back(e.value.stamp);
   std::sort(kidnaps.begin(), kidnaps.end());
   for (const auto& e : r.events)
     if (e.mode == fusion::LocalizerMode::relocalized) fixes.push_back(e.stamp);

@@ -297,7 +297,7 @@ std::vector<Figure> report_figures(const ReplayResult& r, const io::MissionLog& 
   }
   std::vector<std::pair<Eigen::Vector2d, std::string>> marks;
   for (const auto& e : log.events)
-    if (e.value.kind == "kidnap" && !truth.empty())
+    if (e.value.type() == io::EventKind::kidnap && !truth.empty())
       marks.emplace_back(truth.at(e.value.stamp + std::chrono::milliseconds(1)).translation(),
                          "kidnap");
   for (const auto& e : r.events)
@@ -426,7 +426,7 @@ std::string report_html(const ReplayResult& r, const io::MissionLog& log,
   h << "</ul>\n<h2>Lost and relocalized</h2>\n<ul id=\"events\">\n";
   const double t0 = log.wheels.empty() ? 0.0 : to_seconds(log.wheels.front().value.stamp);
   for (const auto& e : log.events)
-    if (e.value.kind == "kidnap")
+    if (e.value.type() == io::EventKind::kidnap)
       h << "<li class=\"bad\">" << num(to_seconds(e.value.stamp) - t0, 2) << " s: kidnapped ("
         << escape(e.value.detail) << ")</li>\n";
   for (const auto& e : r.events)

@@ -323,6 +323,26 @@ void MissionLogWriter::write(Stamp available, const TruthPose& t) {
       topics::kTruth, available, t.stamp,
       Json{{"timestamp", stamp_json(t.stamp)}, {"frame_id", "map"}, {"pose", pose_json(t.pose)}});
 }
+const char* to_string(EventKind kind) {
+  switch (kind) {
+    case EventKind::kidnap:
+      return "kidnap";
+    case EventKind::lamp_failure:
+      return "lamp_failure";
+    case EventKind::frame_drop:
+      return "frame_drop";
+    case EventKind::other:
+      return "other";
+  }
+  return "other";
+}
+
+EventKind event_kind(const std::string& word) {
+  for (const EventKind k : {EventKind::kidnap, EventKind::lamp_failure, EventKind::frame_drop})
+    if (word == to_string(k)) return k;
+  return EventKind::other;
+}
+
 void MissionLogWriter::write(Stamp available, const MissionEvent& e) {
   impl_->put(topics::kEvents, available, e.stamp,
              Json{{"timestamp", stamp_json(e.stamp)}, {"kind", e.kind}, {"detail", e.detail}});

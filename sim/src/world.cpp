@@ -56,7 +56,8 @@ World::World(const Scenario& s, const std::string& log_path)
   log_.attach_map(s.map_geojson);
   const Stamp t0 = stamp_from_nanoseconds(0);
   for (const auto& text : s.commands) log_.write(t0, io::CommandMessage{t0, text});
-  for (const auto& id : s.failed_lamps) log_.write(t0, io::MissionEvent{t0, "lamp_failure", id});
+  for (const auto& id : s.failed_lamps)
+    log_.write(t0, io::MissionEvent{t0, io::EventKind::lamp_failure, id});
   for (const auto& n : s.map.nodes())
     for (const auto& l : n.lamps)
       if (!s.failed_lamps.count(l.id.value)) working_.push_back(&l);
@@ -92,7 +93,8 @@ void World::capture(bool is_ceiling) {
   std::uniform_real_distribution<double> uni(0.0, 1.0);
   if (uni(rng_events_) < s_.frame_drop_probability) {
     ++stats_.dropped_frames;
-    log_.write(t, io::MissionEvent{t, "frame_drop", is_ceiling ? "ceiling_camera" : "omni_camera"});
+    log_.write(t, io::MissionEvent{t, io::EventKind::frame_drop,
+                                   is_ceiling ? "ceiling_camera" : "omni_camera"});
     return;
   }
   const CameraTilt tl = tilt();
@@ -142,7 +144,7 @@ void World::put_down(const Pose2& pose, const std::string& detail) {
   char where[96];
   std::snprintf(where, sizeof where, "put down at (%.2f, %.2f, %.1f deg)", pose.x(), pose.y(),
                 pose.yaw() * 180 / M_PI);
-  log_.write(t, io::MissionEvent{t, "kidnap", detail.empty() ? where : detail});
+  log_.write(t, io::MissionEvent{t, io::EventKind::kidnap, detail.empty() ? where : detail});
   ++stats_.kidnaps;
 }
 

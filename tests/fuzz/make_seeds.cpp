@@ -55,7 +55,7 @@ std::string log_bytes(const std::string& robot, io::McapWriterOptions o) {
     w.write_image(ms(45), {ms(40), "ceiling_camera", "png", io::encode_png(tiny(12, 10))});
     w.write_image(ms(48), {ms(40), "omni_camera", "jpeg", io::encode_jpeg(tiny(16, 16), 80)});
     w.write(ms(20), io::TruthPose{ms(20), Pose2(1, 2, 0.5)});
-    w.write(ms(30), io::MissionEvent{ms(30), "kidnap", "to C3"});
+    w.write(ms(30), io::MissionEvent{ms(30), io::EventKind::kidnap, "to C3"});
     w.write(ms(31), io::CommandMessage{ms(31), "go to J2"});
     w.close();
   }

@@ -240,5 +240,30 @@ TEST(MissionLogWriter, RefusesANegativeTimeAndWritesJpegAsJpeg) {
   std::filesystem::remove(path);
 }
 
+// Events are typed for programs, and a word of another tool comes back as it was written.
+TEST(MissionLog, EventKindsAreTypedAndOtherToolsWordsKept) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("lampnav_events_" + std::to_string(::getpid()) + ".mcap"))
+                               .string();
+  const Stamp t(std::chrono::seconds(3));
+  {
+    MissionLogWriter w(path);
+    w.write(t, WheelReading{t, 0, 0});
+    w.write(t, MissionEvent{t, EventKind::kidnap, "to C3"});
+    w.write(t, MissionEvent{t, "door_opened", "D2"});
+    w.close();
+  }
+  const MissionLog log = read_mission_log(path);
+  std::filesystem::remove(path);
+  ASSERT_EQ(log.events.size(), 2u);
+  EXPECT_EQ(log.events[0].value.type(), EventKind::kidnap);
+  EXPECT_EQ(log.events[0].value.kind, "kidnap");
+  EXPECT_EQ(log.events[0].value.detail, "to C3");
+  EXPECT_EQ(log.events[1].value.type(), EventKind::other);
+  EXPECT_EQ(log.events[1].value.kind, "door_opened");
+  EXPECT_EQ(event_kind("frame_drop"), EventKind::frame_drop);
+  EXPECT_STREQ(to_string(EventKind::lamp_failure), "lamp_failure");
+}
+
 }  // namespace
 }  // namespace lampnav::io

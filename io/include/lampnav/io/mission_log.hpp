@@ -52,10 +52,22 @@ struct TruthPose {
   Pose2 pose;
 };
 
+// What a mission event is, for programs. The log keeps the word it was written with (the spec's
+// list is open: another tool's word is kept and read back as `other`).
+enum class EventKind { kidnap, lamp_failure, frame_drop, other };
+const char* to_string(EventKind kind);  // the spec's word ("other" for other)
+EventKind event_kind(const std::string& word);
+
 struct MissionEvent {
+  MissionEvent() = default;
+  MissionEvent(Stamp at, EventKind k, std::string what)
+      : stamp(at), kind(to_string(k)), detail(std::move(what)) {}
+  MissionEvent(Stamp at, std::string word, std::string what)
+      : stamp(at), kind(std::move(word)), detail(std::move(what)) {}
   Stamp stamp;
-  std::string kind;  // "kidnap", "lamp_failure", "frame_drop", ...
+  std::string kind;  // the log's word: "kidnap", "lamp_failure", "frame_drop", or another tool's
   std::string detail;
+  EventKind type() const { return event_kind(kind); }
 };
 
 struct CommandMessage {
