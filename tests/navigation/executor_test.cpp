@@ -7,22 +7,13 @@
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/graph/route_commands.hpp"
 #include "lampnav_test.hpp"
+#include "office.hpp"
 
 namespace lampnav::navigation {
 namespace {
 
-struct Office {
-  graph::TopologicalMap map =
-      graph::parse_map(test::slurp(test::source_path("maps/office_floor.geojson")), "office").map;
-  // A pose on corridor C1's axis, facing its second end, `along` metres from the first.
-  Pose2 on_c1(double along) const {
-    const graph::Axis& a = *map.find_node("C1")->axis;
-    const Eigen::Vector2d d = a.direction();
-    return {a.point_at(along), std::atan2(d.y(), d.x())};
-  }
-};
-
-Stamp at(double s) { return Stamp(std::chrono::milliseconds(static_cast<long>(s * 1000))); }
+using Office = test::NavOffice;
+Stamp at(double s) { return test::at_s(s); }
 
 fusion::LocalizerEstimate unsure(fusion::LocalizerMode mode, double t, const Pose2& p,
                                  std::vector<Pose2> others = {}) {

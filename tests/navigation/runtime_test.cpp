@@ -11,11 +11,12 @@
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/graph/route_commands.hpp"
 #include "lampnav_test.hpp"
+#include "office.hpp"
 
 namespace lampnav::navigation {
 namespace {
 
-Stamp at(double s) { return Stamp(std::chrono::milliseconds(static_cast<long>(s * 1000))); }
+Stamp at(double s) { return test::at_s(s); }
 
 // An ideal differential drive read at 50 Hz: the wheel speeds the loop set are held for 20 ms and
 // integrated exactly; inputs queued by the test come out first, in their order.
@@ -70,16 +71,7 @@ struct Recorder : RuntimeObserver {
   }
 };
 
-struct Office {
-  RobotDescription robot = read_robot_description(test::source_path("maps/robots/pioneer.json"));
-  graph::TopologicalMap map =
-      graph::parse_map(test::slurp(test::source_path("maps/office_floor.geojson")), "office").map;
-  Pose2 on_c1(double along) const {
-    const graph::Axis& a = *map.find_node("C1")->axis;
-    const Eigen::Vector2d d = a.direction();
-    return {a.point_at(along), std::atan2(d.y(), d.x())};
-  }
-};
+using Office = test::NavOffice;
 
 // With the start given and wheels that do what they are told, the loop drives the route to its
 // goal on dead reckoning alone, one estimate per wheel reading.
