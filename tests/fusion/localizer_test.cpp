@@ -106,7 +106,8 @@ Outcome replay(const sim::Scenario& s, const io::MissionLog& log, const graph::T
                    [](const Item& a, const Item& b) { return a.arrival < b.arrival; });
   Outcome run;
   for (const auto& e : log.events)
-    if (e.value.type() == io::EventKind::kidnap) run.kidnaps.push_back({e.value.stamp, false, {}, {}});
+    if (e.value.type() == io::EventKind::kidnap)
+      run.kidnaps.push_back({e.value.stamp, false, {}, {}});
   // Scored only while the estimate should be right: tracking, and not between a kidnap and the
   // relocalization that follows it.
   bool unsure = false;

@@ -64,7 +64,8 @@ TEST(Scenario, MissionLogHoldsWhatTheSpecLists) {
   EXPECT_EQ(log.commands.front().value.text, "follow corridor C1");
   bool failure_event = false;
   for (const auto& e : log.events)
-    failure_event = failure_event || (e.value.type() == io::EventKind::lamp_failure && e.value.detail == "C1-L3");
+    failure_event = failure_event ||
+                    (e.value.type() == io::EventKind::lamp_failure && e.value.detail == "C1-L3");
   EXPECT_TRUE(failure_event);
   // Camera frames become available a second after they were captured (paper 2), and the log is
   // in availability order.

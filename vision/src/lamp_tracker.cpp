@@ -198,19 +198,20 @@ TrackedFrame LampTracker::Impl::process(const ImageView& image) {
   TrackedFrame out;
   out.ended = std::move(pending_ended);
   pending_ended.clear();
+  // Pixels a windowed attempt read before the frame had to be read whole still count.
+  long tried = 0;
   if (const auto boxes = windows()) {
-    const long ring = 2L * (g.width + g.height) - 4;
+    tried = 2L * (g.width + g.height) - 4;  // the border ring
     if (!ring_unexplained(g, *boxes)) {
-      LampDetections found = detector.detect_in(g, *boxes);
-      if (!found.spilled) {
-        TrackedFrame windowed = out;
-        if (associate(found, true, windowed)) {
-          windowed.stats = found.stats;
-          windowed.whole = false;
-          windowed.pixels_read = found.pixels_read + ring;
-          ++since_whole;
-          return windowed;
-        }
+      const LampDetections found = detector.detect_in(g, *boxes);
+      tried += found.pixels_read;
+      // associate() leaves `out` as it was when it refuses a windowed frame.
+      if (!found.spilled && associate(found, true, out)) {
+        out.stats = found.stats;
+        out.whole = false;
+        out.pixels_read = tried;
+        ++since_whole;
+        return out;
       }
     }
   }
@@ -218,7 +219,7 @@ TrackedFrame LampTracker::Impl::process(const ImageView& image) {
   associate(found, false, out);
   out.stats = found.stats;
   out.whole = true;
-  out.pixels_read = found.pixels_read;
+  out.pixels_read = tried + found.pixels_read;
   since_whole = 0;
   return out;
 }
