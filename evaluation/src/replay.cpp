@@ -15,12 +15,6 @@
 
 namespace lampnav::evaluation {
 
-namespace {
-
-constexpr double kDeg = M_PI / 180.0;
-
-}  // namespace
-
 // ---------------------------------------------------------------------------------------------
 // The recorded robot.
 
@@ -106,21 +100,6 @@ struct Recorder : navigation::RuntimeObserver {
   }
 };
 
-ErrorStats stats_of(const std::vector<double>& v) {
-  ErrorStats s;
-  s.n = v.size();
-  if (v.empty()) return s;
-  double sum = 0, sum2 = 0;
-  for (double x : v) {
-    sum += x;
-    sum2 += x * x;
-    s.max = std::max(s.max, x);
-  }
-  s.mean = sum / v.size();
-  s.rms = std::sqrt(sum2 / v.size());
-  return s;
-}
-
 // Why a replay never published a pose, in words: what the localizer last said.
 std::string never_localized(const ReplayResult& r, const io::MissionLog& log) {
   std::string s = "the robot was never localized";
@@ -145,7 +124,6 @@ void note_input_faults(ReplayResult& r, const fusion::LocalizerCounts& c) {
   constexpr std::size_t kShown = 3;
   for (int s = 0; s < 3; ++s) {
     const navigation::InputFaultCounts& n = r.outcome.faults[s];
-    r.metrics.input_faults[s] = n;
     if (n.total() == 0) continue;
     std::string line = std::string(to_string(static_cast<navigation::InputStream>(s))) + ": " +
                        std::to_string(n.gaps) + " gaps (longest " + one_decimal(n.longest_gap_s) +
@@ -156,93 +134,9 @@ void note_input_faults(ReplayResult& r, const fusion::LocalizerCounts& c) {
       if (static_cast<int>(f.stream) == s && shown++ < kShown) line += "; " + f.text();
     r.notes.push_back(line);
   }
-  r.metrics.frames_too_old = c.frames_too_old;
   if (c.frames_too_old > 0)
     r.notes.push_back(std::to_string(c.frames_too_old) +
                       " frames captured before the filter's history (too late to apply)");
-}
-
-void score(ReplayResult& r, const io::MissionLog& log) {
-  Metrics& m = r.metrics;
-  m.ceiling_frames = r.outcome.ceiling_frames;
-  m.omni_frames = r.outcome.omni_frames;
-  m.frames = m.ceiling_frames + m.omni_frames;
-  m.duration_s = r.outcome.duration_s();
-  for (const auto& f : r.lamp_frames)
-    for (const auto& l : f.observations.lamps) {
-      ++m.lamps_seen;
-      if (l.label) ++m.lamps_labelled;
-    }
-  // Time lost, time ambiguous.
-  for (std::size_t k = 1; k < r.estimates.size(); ++k) {
-    const double dt = to_seconds(r.estimates[k].stamp - r.estimates[k - 1].stamp);
-    if (r.estimates[k - 1].mode == fusion::LocalizerMode::lost) m.lost_s += dt;
-    if (r.estimates[k - 1].mode == fusion::LocalizerMode::ambiguous) m.ambiguous_s += dt;
-  }
-  // Kidnaps and the fixes after them.
-  std::vector<Stamp> kidnaps, fixes;
-  for (const auto& e : log.events)
-    if (e.value.type() == io::EventKind::kidnap) kidnaps.push_back(e.value.stamp);
-  std::sort(kidnaps.begin(), kidnaps.end());
-  for (const auto& e : r.events)
-    if (e.mode == fusion::LocalizerMode::relocalized) fixes.push_back(e.stamp);
-  m.kidnaps = static_cast<int>(kidnaps.size());
-  std::vector<double> latency;
-  std::vector<std::pair<Stamp, std::optional<Stamp>>> unsure;  // kidnap to its fix
-  for (std::size_t k = 0; k < kidnaps.size(); ++k) {
-    const Stamp until = k + 1 < kidnaps.size() ? kidnaps[k + 1] : Stamp::max();
-    auto fix = std::find_if(fixes.begin(), fixes.end(),
-                            [&](Stamp s) { return s >= kidnaps[k] && s < until; });
-    if (fix != fixes.end()) {
-      ++m.recoveries;
-      latency.push_back(to_seconds(*fix - kidnaps[k]));
-      unsure.push_back({kidnaps[k], *fix});
-    } else {
-      unsure.push_back({kidnaps[k], std::nullopt});
-    }
-  }
-  m.relocalization_latency_s = stats_of(latency);
-  // Errors: tracking estimates outside [kidnap, its fix).
-  m.has_truth = !log.truth.empty();
-  if (!m.has_truth) return;
-  const io::TruthTrack truth(log.truth);
-  std::vector<double> pos, yaw;
-  for (const auto& e : r.estimates) {
-    if (e.mode != fusion::LocalizerMode::tracking) continue;
-    bool skip = false;
-    for (const auto& [from, to] : unsure)
-      if (e.stamp >= from && (!to || e.stamp < *to)) skip = true;
-    if (skip) continue;
-    const Pose2 t = truth.at(e.stamp);
-    pos.push_back((e.pose.translation() - t.translation()).norm());
-    yaw.push_back(std::fabs(wrap_angle(e.pose.yaw() - t.yaw())) / kDeg);
-  }
-  m.position_error_m = stats_of(pos);
-  m.yaw_error_deg = stats_of(yaw);
-  // Wrong fixes: a pose published as certain more than 0.5 m off, except between a kidnap and
-  // the localizer noticing it (the first mode change after it), 10 s at most.
-  std::vector<std::pair<Stamp, Stamp>> unnoticed;
-  for (const Stamp k : kidnaps) {
-    Stamp until = k + std::chrono::seconds(10);
-    for (const auto& e : r.events)
-      if (e.stamp >= k && e.mode != fusion::LocalizerMode::tracking) {
-        until = std::min(until, e.stamp);
-        break;
-      }
-    unnoticed.emplace_back(k, until);
-  }
-  bool wrong = false;
-  for (const auto& e : r.estimates) {
-    const bool certain = fusion::is_certain(e.mode);
-    bool excused = false;
-    for (const auto& [from, to] : unnoticed)
-      if (e.stamp >= from && e.stamp <= to) excused = true;  // an estimate at the instant of
-    // the event was published before the frame that showed it
-    const bool off = certain && !excused &&
-                     (e.pose.translation() - truth.at(e.stamp).translation()).norm() > 0.5;
-    if (off && !wrong) ++m.wrong_fixes;
-    wrong = off;
-  }
 }
 
 }  // namespace
@@ -282,7 +176,7 @@ ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
   rec.r = &r;
   const auto t0 = std::chrono::steady_clock::now();
   r.outcome = rt.run(robot_in, options.initial_pose, {}, &rec);
-  r.metrics.runtime_s =
+  const double runtime_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (const auto& p : robot_in.problems()) r.notes.push_back("skipped " + p);
   note_input_faults(r, rt.localizer().counts());
@@ -308,9 +202,10 @@ ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
   } else {
     r.notes.push_back(never_localized(r, log));
   }
-  score(r, log);
-  r.metrics.realtime_factor =
-      r.metrics.runtime_s > 0 ? r.metrics.duration_s / r.metrics.runtime_s : 0.0;
+  r.metrics = score(r, log);
+  r.metrics.frames_too_old = rt.localizer().counts().frames_too_old;
+  r.metrics.runtime_s = runtime_s;
+  r.metrics.realtime_factor = runtime_s > 0 ? r.metrics.duration_s / runtime_s : 0.0;
   return r;
 }
 
@@ -368,48 +263,6 @@ std::string tum(const std::vector<std::pair<Stamp, Pose2>>& poses) {
     out += line;
   }
   return out;
-}
-
-std::string metrics_json(const Metrics& m) {
-  using Json = nlohmann::ordered_json;
-  auto err = [&](const ErrorStats& s) -> Json {
-    if (!m.has_truth || s.n == 0) return nullptr;
-    return Json{{"mean", s.mean}, {"rms", s.rms}, {"max", s.max}, {"samples", s.n}};
-  };
-  Json j;
-  j["frames"] = m.frames;
-  j["ceiling_frames"] = m.ceiling_frames;
-  j["omni_frames"] = m.omni_frames;
-  j["duration_s"] = m.duration_s;
-  j["has_truth"] = m.has_truth;
-  j["position_error_m"] = err(m.position_error_m);
-  j["yaw_error_deg"] = err(m.yaw_error_deg);
-  j["lost_s"] = m.lost_s;
-  j["ambiguous_s"] = m.ambiguous_s;
-  j["wrong_fixes"] = m.has_truth ? Json(m.wrong_fixes) : Json(nullptr);
-  j["kidnaps"] = m.kidnaps;
-  j["recoveries"] = m.recoveries;
-  j["relocalization_latency_s"] =
-      m.relocalization_latency_s.n
-          ? Json{{"mean", m.relocalization_latency_s.mean}, {"max", m.relocalization_latency_s.max}}
-          : Json(nullptr);
-  j["lamps_seen"] = m.lamps_seen;
-  j["lamps_labelled"] = m.lamps_labelled;
-  Json faults;
-  for (int s = 0; s < 3; ++s) {
-    const navigation::InputFaultCounts& f = m.input_faults[s];
-    faults[s == 0   ? "wheels"
-           : s == 1 ? "ceiling"
-                    : "omni"] = {{"gaps", f.gaps},
-                                 {"longest_gap_s", f.longest_gap_s},
-                                 {"duplicates", f.duplicates},
-                                 {"out_of_order", f.out_of_order}};
-  }
-  j["input_faults"] = faults;
-  j["frames_too_old"] = m.frames_too_old;
-  j["runtime_s"] = m.runtime_s;
-  j["realtime_factor"] = m.realtime_factor;
-  return j.dump(2) + "\n";
 }
 
 void write_replay(const ReplayResult& r, const io::MissionLog& log,

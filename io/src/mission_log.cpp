@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -72,7 +73,14 @@ std::string base64_decode(const std::string& text) {
         continue;
       }
       if (pad > 0 || table[static_cast<unsigned char>(c)] < 0) {
-        throw std::invalid_argument("bad character at " + std::to_string(i + k));
+        const unsigned char u = static_cast<unsigned char>(c);
+        char shown[16];
+        if (u >= 0x21 && u < 0x7f)
+          std::snprintf(shown, sizeof shown, "'%c'", c);
+        else
+          std::snprintf(shown, sizeof shown, "byte 0x%02x", u);
+        throw std::invalid_argument(std::string("bad character ") + shown + " at " +
+                                    std::to_string(i + k));
       }
       v[k] = table[static_cast<unsigned char>(c)];
     }
