@@ -128,6 +128,47 @@ void GlobalLocalizer::Impl::index_lamps() {
   for (const auto* l : lamps) longest = std::max(longest, l->length);
   const double theta = std::min(q.max_theta_deg * kDeg, 89.5 * kDeg);
   view_radius = max_height * std::tan(theta) + offset + longest + 1.0;
+  grid_lamps();
+}
+
+void GlobalLocalizer::Impl::grid_lamps() {
+  lamp_xy.clear();
+  lamp_cos_yaw.clear();
+  lamp_sin_yaw.clear();
+  for (const auto* l : lamps) {
+    lamp_xy.push_back(l->xyz.head<2>());
+    lamp_cos_yaw.push_back(std::cos(l->yaw));
+    lamp_sin_yaw.push_back(std::sin(l->yaw));
+  }
+  grid = LampGrid{};
+  if (lamps.empty()) return;
+  Vector2d lo = lamp_xy.front(), hi = lo;
+  for (const auto& p : lamp_xy) {
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  // Cells of half the view radius, at most 2^18 of them whatever the map's extent.
+  constexpr double kMaxCells = 1 << 18;
+  const Vector2d extent = (hi - lo).cwiseMax(Vector2d(1e-3, 1e-3));
+  grid.cell = std::max({0.5 * view_radius, 1e-3, std::sqrt(extent.x() * extent.y() / kMaxCells),
+                        extent.maxCoeff() / 4096});
+  grid.origin = lo;
+  grid.columns = static_cast<int>(extent.x() / grid.cell) + 1;
+  grid.rows = static_cast<int>(extent.y() / grid.cell) + 1;
+  const std::size_t cells = static_cast<std::size_t>(grid.columns) * grid.rows;
+  std::vector<int> cell_of(lamps.size());
+  grid.start.assign(cells + 1, 0);
+  for (std::size_t i = 0; i < lamps.size(); ++i) {
+    const Vector2d q = (lamp_xy[i] - lo) / grid.cell;
+    const int cx = std::min(grid.columns - 1, static_cast<int>(q.x()));
+    const int cy = std::min(grid.rows - 1, static_cast<int>(q.y()));
+    cell_of[i] = cy * grid.columns + cx;
+    ++grid.start[cell_of[i] + 1];
+  }
+  for (std::size_t c = 0; c < cells; ++c) grid.start[c + 1] += grid.start[c];
+  grid.lamps.assign(lamps.size(), 0);
+  std::vector<int> fill(grid.start.begin(), grid.start.end() - 1);
+  for (std::size_t i = 0; i < lamps.size(); ++i) grid.lamps[fill[cell_of[i]]++] = int(i);
 }
 
 std::vector<int> GlobalLocalizer::Impl::lamps_in_view(const Pose2& pose, double radius) const {
@@ -137,19 +178,46 @@ std::vector<int> GlobalLocalizer::Impl::lamps_in_view(const Pose2& pose, double 
     for (std::size_t i = 0; i < lamps.size(); ++i) out[i] = static_cast<int>(i);
     return out;
   }
-  map->visit_lamps_within(pose.translation(), radius > 0 ? radius : view_radius,
-                          [&](const graph::Lamp& l) { out.push_back(lamp_index.at(&l)); });
-  std::sort(out.begin(), out.end());  // the map's order, so that results do not depend on the index
+  if (lamps.empty()) return out;
+  const double r = radius > 0 ? radius : view_radius;
+  const Vector2d p = pose.translation();
+  const Vector2d lo = (p - Vector2d(r, r) - grid.origin) / grid.cell;
+  const Vector2d hi = (p + Vector2d(r, r) - grid.origin) / grid.cell;
+  if (!(hi.x() >= 0 && hi.y() >= 0 && lo.x() < grid.columns && lo.y() < grid.rows)) return out;
+  auto cell = [](double v, int n) { return static_cast<int>(std::clamp(v, 0.0, n - 1.0)); };
+  const int x0 = cell(lo.x(), grid.columns), x1 = cell(hi.x(), grid.columns);
+  const int y0 = cell(lo.y(), grid.rows), y1 = cell(hi.y(), grid.rows);
+  for (int y = y0; y <= y1; ++y)
+    for (int x = x0; x <= x1; ++x) {
+      const int c = y * grid.columns + x;
+      for (int k = grid.start[c]; k < grid.start[c + 1]; ++k) {
+        const int i = grid.lamps[k];
+        // The map's own test (TopologicalMap::visit_lamps_within), to the bit.
+        if ((lamp_xy[i] - p).squaredNorm() <= r * r) out.push_back(i);
+      }
+    }
+  std::sort(out.begin(), out.end());  // the map's order, so that results do not depend on cells
   return out;
 }
 
 Vector3d GlobalLocalizer::Impl::camera_point(const Pose2& pose, const Vector3d& lamp,
                                              const Tilt& tilt) const {
-  const double c = std::cos(pose.yaw()), s = std::sin(pose.yaw());
-  const Vector3d d(lamp.x() - pose.x(), lamp.y() - pose.y(), lamp.z());
-  Vector3d base(c * d.x() + s * d.y(), -s * d.x() + c * d.y(), d.z());
-  if (tilt.roll != 0 || tilt.pitch != 0) base = tilt.inverse_rotation() * base;
-  return mount_Rt * (base - mount_t);
+  return CameraView(*this, pose, tilt).point(lamp);
+}
+
+GlobalLocalizer::Impl::CameraView::CameraView(const Impl& impl, const Pose2& pose, const Tilt& tilt)
+    : impl_(&impl),
+      pose_(pose),
+      c_(std::cos(pose.yaw())),
+      s_(std::sin(pose.yaw())),
+      tilted_(tilt.roll != 0 || tilt.pitch != 0),
+      tilt_inverse_(tilted_ ? tilt.inverse_rotation() : Matrix3d::Identity()) {}
+
+Vector3d GlobalLocalizer::Impl::CameraView::point(const Vector3d& lamp) const {
+  const Vector3d d(lamp.x() - pose_.x(), lamp.y() - pose_.y(), lamp.z());
+  Vector3d base(c_ * d.x() + s_ * d.y(), -s_ * d.x() + c_ * d.y(), d.z());
+  if (tilted_) base = tilt_inverse_ * base;
+  return impl_->mount_Rt * (base - impl_->mount_t);
 }
 
 std::vector<GlobalLocalizer::Impl::BlobRay> GlobalLocalizer::Impl::blob_rays(
@@ -162,12 +230,12 @@ std::vector<GlobalLocalizer::Impl::BlobRay> GlobalLocalizer::Impl::blob_rays(
   return out;
 }
 
-double GlobalLocalizer::Impl::blob_half_size(const graph::Lamp& l, const Vector3d& sight,
-                                             double range) {
+double GlobalLocalizer::Impl::blob_half_size(int lamp, const Vector3d& sight, double range) const {
   // Half the angle the lamp spans along and across itself, as seen along `sight` (the unit
   // vector from the camera to it, in the map): a lamp seen end-on far off-axis spans little,
   // one overhead much; and the bloom around it.
-  const double c = std::cos(l.yaw), s = std::sin(l.yaw);
+  const graph::Lamp& l = *lamps[lamp];
+  const double c = lamp_cos_yaw[lamp], s = lamp_sin_yaw[lamp];
   const double along = c * sight.x() + s * sight.y(), across = -s * sight.x() + c * sight.y();
   const double w = l.width > 0 ? l.width : l.length;
   const double half = 0.5 * std::max(l.length * std::sqrt(std::max(0.0, 1 - along * along)),
@@ -197,8 +265,11 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
   std::vector<Predicted> pred;
   const Vector2d mount_xy = pose.transform_from(mount_t.head<2>());
   const Vector3d camera_at(mount_xy.x(), mount_xy.y(), mount_t.z());
-  for (const int i : lamps_in_view(pose, radius)) {
-    const Vector3d c = camera_point(pose, lamps[i]->xyz, tilt);
+  const CameraView view(*this, pose, tilt);
+  const std::vector<int> in_view = lamps_in_view(pose, radius);
+  pred.reserve(in_view.size());
+  for (const int i : in_view) {
+    const Vector3d c = view.point(lamps[i]->xyz);
     const double range = c.norm();
     if (!(range > 0.1)) continue;
     const Vector3d ray = c / range;
@@ -209,7 +280,7 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     const double sigma =
         std::sqrt(det * det + tilt_sigma * tilt_sigma + pos * pos + yaw * yaw + face * face);
     const Vector3d sight = (lamps[i]->xyz - camera_at) / range;
-    pred.push_back({ray, theta, sigma, blob_half_size(*lamps[i], sight, range), int(i)});
+    pred.push_back({ray, theta, sigma, blob_half_size(i, sight, range), i});
   }
   // Lamps whose blobs may merge in the image are not expected to match a blob of their own, only
   // to lie under some blob (a merged blob's centre may fall between them). Angles between unit
@@ -221,19 +292,25 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
       if ((pred[a].ray - pred[b].ray).squaredNorm() < limit * limit)
         pred[a].crowded = pred[b].crowded = true;
     }
+  // Lamp-blob pairs within 3 sigma. The division is done only for pairs that may be within it.
   struct Pair {
     double cost;
     int p, b;
   };
   std::vector<Pair> pairs;
+  pairs.reserve(4 * std::max(pred.size(), blobs.size()));
   std::vector<char> explained(blobs.size(), 0);
+  std::vector<double> blob_term(blobs.size());
+  for (std::size_t j = 0; j < blobs.size(); ++j)
+    blob_term[j] = 0.25 * blobs[j].angular_radius * blobs[j].angular_radius;
   for (std::size_t i = 0; i < pred.size(); ++i) {
     const double reach = pred[i].half_size + 3 * pred[i].sigma;
+    const double sigma2 = pred[i].sigma * pred[i].sigma;
     for (std::size_t j = 0; j < blobs.size(); ++j) {
-      const double s2 =
-          pred[i].sigma * pred[i].sigma + 0.25 * blobs[j].angular_radius * blobs[j].angular_radius;
+      const double s2 = sigma2 + blob_term[j];
       const double chord2 = (pred[i].ray - blobs[j].ray).squaredNorm();
       if (chord2 < reach * reach) pred[i].covered = true;
+      if (chord2 > 9.0 * (1 + 1e-9) * s2) continue;  // beyond 3 sigma, rounding aside
       const double d2 = chord2 / s2;
       if (d2 <= 9.0) {
         explained[j] = 1;

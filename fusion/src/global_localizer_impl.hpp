@@ -78,6 +78,7 @@ struct GlobalLocalizer::Impl {
   using Tilt = detail::Tilt;
   using ParticleRandom = detail::ParticleRandom;
   using Matrix3d = detail::Matrix3d;
+  using Vector2d = detail::Vector2d;
   using Vector3d = detail::Vector3d;
 
   const graph::TopologicalMap* map;
@@ -106,13 +107,25 @@ struct GlobalLocalizer::Impl {
     int a, b;
   };
   std::vector<std::pair<std::pair<int, int>, std::vector<LampPair>>> pair_groups;
-  // The lamps a pose can see (within max_theta), found through the map's spatial index on big
-  // maps; on small ones all of them.
+  // The lamps a pose can see (within max_theta): on small maps all of them, on big ones those
+  // within view_radius, found in a grid of the lamps' indices (cells in one array, by cell).
+  // Scoring a pose asks this thousands of times a frame: it returns the map's lamps in the
+  // map's order, as the map's own spatial index would, without its callbacks and pointers.
   std::unordered_map<const graph::Lamp*, int> lamp_index;
   double view_radius = 0;
   double max_height = 0;  // of a lamp above the camera
+  struct LampGrid {
+    Vector2d origin = Vector2d::Zero();
+    double cell = 1;
+    int columns = 0, rows = 0;
+    std::vector<int> start;  // per cell, into `lamps`; one more at the end
+    std::vector<int> lamps;  // lamp indices, cell by cell, each cell in the map's order
+  } grid;
+  std::vector<Vector2d> lamp_xy;                   // per lamp
+  std::vector<double> lamp_cos_yaw, lamp_sin_yaw;  // per lamp
   void index_lamps();
-  // The lamps within `radius` of the pose (default: view_radius).
+  void grid_lamps();
+  // The lamps within `radius` of the pose (default: view_radius), in the map's order.
   std::vector<int> lamps_in_view(const Pose2& pose, double radius = 0) const;
 
   Impl(const graph::TopologicalMap& m, const CameraDescription& camera,
@@ -124,6 +137,19 @@ struct GlobalLocalizer::Impl {
   // Scoring a pose. The lamp in the camera frame from a robot pose, the base tilted by the floor
   // (roll about x, then pitch about y, as conventions.md orders roll-pitch-yaw).
   Vector3d camera_point(const Pose2& pose, const Vector3d& lamp, const Tilt& tilt = {}) const;
+  // The same for many lamps from one pose: its sine, cosine and tilt taken once.
+  class CameraView {
+   public:
+    CameraView(const Impl& impl, const Pose2& pose, const Tilt& tilt);
+    Vector3d point(const Vector3d& lamp) const;
+
+   private:
+    const Impl* impl_;
+    Pose2 pose_;
+    double c_, s_;
+    bool tilted_;
+    Matrix3d tilt_inverse_;
+  };
 
   std::vector<BlobRay> blob_rays(const vision::OmniDetection& d, double max_theta) const;
 
@@ -133,7 +159,7 @@ struct GlobalLocalizer::Impl {
   // Half the angular size (rad) of a lamp's blob seen along `sight` (unit, camera to lamp, in
   // the map) from `range`: the IR bloom makes it larger than the lamp by kBloom.
   static constexpr double kBloom = 0.05;
-  static double blob_half_size(const graph::Lamp& l, const Vector3d& sight, double range);
+  double blob_half_size(int lamp, const Vector3d& sight, double range) const;
 
   // Scores a pose known within (position_sigma, yaw_sigma) and a floor tilt known within
   // tilt_sigma: predicted lamps matched one-to-one to blobs, nearest first, within 3 sigma.
