@@ -126,9 +126,12 @@ std::vector<double> numbers(const Node& n, const std::string& field, const Where
     if (!n["rows"].empty() && !n["cols"].empty()) {
       const double rows = number(n["rows"], field + ".rows", w),
                    cols = number(n["cols"], field + ".cols", w);
+      for (const auto& [v, part] : {std::pair{rows, ".rows"}, std::pair{cols, ".cols"}})
+        if (v != std::floor(v) || v < 0 || v > 1e6)
+          w.fail(field + part, "must be a whole count, 0 to 1000000");
       if (rows * cols != double(out.size()))
-        w.fail(field, "rows x cols is " + std::to_string(int(rows * cols)) + " but data holds " +
-                          std::to_string(out.size()) + " numbers");
+        w.fail(field, "rows x cols is " + std::to_string(static_cast<long long>(rows * cols)) +
+                          " but data holds " + std::to_string(out.size()) + " numbers");
     }
     return out;
   }

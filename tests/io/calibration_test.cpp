@@ -223,6 +223,11 @@ TEST(Calibration, WhatCannotBeReadIsRefusedNamingFileAndField) {
       "image_width: 320\nimage_height: 240\ncamera_matrix: {rows: 3, cols: 3, data: [300, 0, "
       "160, 0, 300, 120]}\ndistortion_model: plumb_bob\ndistortion_coefficients: [0, 0, 0, 0]\n",
       "camera_matrix", "data holds 6 numbers");
+  // Found by the fuzzer: a count beyond any int was cast to one.
+  refused("huge_rows.yaml",
+          "image_width: 320\nimage_height: 240\ncamera_matrix: {rows: 4e84, cols: 3, data: [300, "
+          "0, 160]}\ndistortion_model: plumb_bob\ndistortion_coefficients: [0, 0, 0, 0]\n",
+          "camera_matrix.rows", "whole count");
   refused("width.yaml",
           "image_width: -3\nimage_height: 240\n" + matrix +
               "distortion_model: plumb_bob\ndistortion_coefficients: [0, 0, 0, 0]\n",
