@@ -41,22 +41,30 @@ std::pair<std::uint32_t, std::uint32_t> declared_size(const std::string& b, bool
   auto be16 = [&](std::size_t i) { return u8(i) << 8 | u8(i + 1); };
   auto be32 = [&](std::size_t i) { return be16(i) << 16 | be16(i + 2); };
   if (png) return b.size() >= 24 ? std::pair{be32(16), be32(20)} : std::pair{0u, 0u};
-  // JPEG: markers after SOI; a start-of-frame (C0..CF but C4, C8, CC) holds height then width.
+  // JPEG: the markers after SOI, read as libjpeg reads them (jdmarker.c's next_marker): bytes
+  // that are not a marker are skipped up to the next 0xFF, fill bytes 0xFF are skipped, and each
+  // segment is passed over by its length. The first start-of-frame (C0..CF but C4, C8, CC) holds
+  // height then width. A scan (DA) before any frame header, or no frame header at all: 0, 0.
   std::size_t i = 2;
-  while (i + 9 < b.size()) {
-    if (u8(i) != 0xFF) return {0, 0};
+  while (i + 1 < b.size()) {
+    if (u8(i) != 0xFF) {
+      ++i;  // an extraneous byte: libjpeg warns and skips it
+      continue;
+    }
     const std::uint32_t marker = u8(i + 1);
     if (marker == 0xFF) {
       ++i;
       continue;
     }
-    if (marker >= 0xD0 && marker <= 0xD9) {
-      i += 2;
+    if (marker == 0x00 || marker == 0x01 || (marker >= 0xD0 && marker <= 0xD9)) {
+      i += 2;  // a stuffed byte (extraneous here), TEM, RSTn, SOI, EOI: no length follows
       continue;
     }
+    if (marker == 0xDA) return {0, 0};
+    if (i + 3 >= b.size()) return {0, 0};
     const std::uint32_t length = be16(i + 2);
     if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC)
-      return {be16(i + 7), be16(i + 5)};
+      return i + 8 < b.size() ? std::pair{be16(i + 7), be16(i + 5)} : std::pair{0u, 0u};
     i += 2 + length;
   }
   return {0, 0};
@@ -72,6 +80,10 @@ Image8 decode_image(const std::string& bytes, const std::string& source) {
   if (!png && !jpeg) throw InputError({source, "", ""}, "not a PNG or JPEG image");
   constexpr std::uint64_t kMaxPixels = 64ull << 20;  // 8192 x 8192
   const auto [w, h] = declared_size(bytes, png);
+  // Nothing is decoded whose size is not known first: a JPEG with no frame header before its
+  // scan would not decode anyway, and one the header scan missed could ask for gigapixels.
+  if (!png && (w == 0 || h == 0))
+    throw InputError({source, "", ""}, "JPEG without a frame header (SOF) before its scan");
   if (std::uint64_t(w) * h > kMaxPixels)
     throw InputError({source, "", ""}, "image of " + std::to_string(w) + " x " + std::to_string(h) +
                                            " pixels: more than lampnav reads");

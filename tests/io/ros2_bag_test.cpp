@@ -474,6 +474,39 @@ TEST(Images, OnlyPngAndJpegOfASizeLampnavReads) {
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), HasSubstr("65536 x 65536 pixels"));
   }
+  // Found by the fuzzer's long run: stray bytes before the frame header hid it from the header
+  // scan, and libjpeg, which skips them, decoded 27,000 x 25,714 pixels (12 s, 700 MB). The scan
+  // now skips them as libjpeg does.
+  const std::string jpeg = encode_jpeg(g, 90);
+  const std::size_t sof = jpeg.find("\xFF\xC0");
+  ASSERT_NE(sof, std::string::npos);
+  std::string hidden = jpeg.substr(0, sof) + std::string("\x1e\x1d\x1a\x1c", 4) + jpeg.substr(sof);
+  hidden[sof + 4 + 5] = '\x64';  // height 0x6472
+  hidden[sof + 4 + 6] = '\x72';
+  hidden[sof + 4 + 7] = '\x69';  // width 0x6976
+  hidden[sof + 4 + 8] = '\x76';
+  try {
+    decode_image(hidden, "hidden.jpg");
+    ADD_FAILURE() << "a 694-megapixel frame header behind stray bytes was decoded";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("26998 x 25714 pixels"));
+  }
+  // The same stray bytes before a frame of the image's own size: read, as libjpeg reads it.
+  const std::string stray =
+      jpeg.substr(0, sof) + std::string("\x1e\x1d\x1a\x1c", 4) + jpeg.substr(sof);
+  EXPECT_EQ(decode_image(stray, "stray.jpg").width, 9);
+  // No frame header before the scan: refused before decoding.
+  const std::size_t sos = jpeg.find("\xFF\xDA");
+  std::string headless = jpeg;
+  headless.erase(sof, 2 + ((static_cast<unsigned char>(jpeg[sof + 2]) << 8) |
+                           static_cast<unsigned char>(jpeg[sof + 3])));
+  ASSERT_LT(sof, sos);
+  try {
+    decode_image(headless, "headless.jpg");
+    ADD_FAILURE() << "a JPEG without a frame header was decoded";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("frame header"));
+  }
 }
 
 }  // namespace
