@@ -369,6 +369,9 @@ GlobalLocalizer::Impl::Solution GlobalLocalizer::Impl::solve(Pose2 pose, Tilt ti
     dRz_t << -s, c, 0, -c, -s, 0, 0, 0, 0;
     const Matrix3d T = tilt.inverse_rotation();
     const auto [dT_roll, dT_pitch] = tilt.inverse_rotation_derivatives();
+    // A lamp's point moves alike for every lamp as the robot moves along x or y.
+    const Vector3d d_by_x = mount_Rt * (T * (Rz_t * Vector3d(-1, 0, 0)));
+    const Vector3d d_by_y = mount_Rt * (T * (Rz_t * Vector3d(0, -1, 0)));
     for (const auto& [li, bj] : e.matches) {
       const Vector3d L = lamps[li]->xyz;
       const Vector3d d(L.x() - pose.x(), L.y() - pose.y(), L.z());
@@ -378,8 +381,8 @@ GlobalLocalizer::Impl::Solution GlobalLocalizer::Impl::solve(Pose2 pose, Tilt ti
       const Vector3d ray = cpt / n;
       const Matrix3d dn = (Matrix3d::Identity() - ray * ray.transpose()) / n;
       Eigen::Matrix<double, 3, 5> dc;
-      dc.col(0) = mount_Rt * (T * (Rz_t * Vector3d(-1, 0, 0)));
-      dc.col(1) = mount_Rt * (T * (Rz_t * Vector3d(0, -1, 0)));
+      dc.col(0) = d_by_x;
+      dc.col(1) = d_by_y;
       dc.col(2) = mount_Rt * (T * (dRz_t * d));
       dc.col(3) = mount_Rt * (dT_roll * b);
       dc.col(4) = mount_Rt * (dT_pitch * b);
@@ -433,7 +436,9 @@ PoseHypothesis GlobalLocalizer::Impl::refine(Pose2 pose, double position_sigma, 
     const double ps = std::min(position_sigma, std::max(0.03, std::sqrt(cov(0, 0) + cov(1, 1))));
     const double ys = std::min(yaw_sigma, std::max(0.5 * kDeg, std::sqrt(cov(2, 2))));
     ts = &sol == &level ? tilt_sigma : std::min(tilt_sigma, std::sqrt(sol.tilt_covariance.trace()));
-    e = evaluate(pose, tilt, ps, ys, ts, blobs);
+    // Matched again with the tolerance the solution earned, for the next round (after the last,
+    // the score below matches anew).
+    if (round + 1 < rounds) e = evaluate(pose, tilt, ps, ys, ts, blobs);
   }
   // Scored with one common tolerance, so hypotheses compare.
   e = evaluate(pose, tilt, 0.05, 0.5 * kDeg, ts, blobs);
