@@ -1,9 +1,13 @@
 // lampnav locate --map M --robot R.json --image IMG [--camera omni_camera]
 //                [--method paper|default] [--json]
+// lampnav locate --map M [--robot R.json] --log LOG.mcap [--at SECONDS] [bag topic options] ...
 // Global localization from one omnidirectional image: ranked pose hypotheses with their merit,
-// the lamps each matched and the node each lies in.
+// the lamps each matched and the node each lies in. The image is a file, or an omni frame of a
+// mission log or ROS 2 bag (the first captured at or after --at; the robot defaults to the
+// log's robot.json, a bag's camera mount to its transforms).
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
@@ -11,6 +15,7 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "commands.hpp"
@@ -28,9 +33,43 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 
 struct LocateArgs {
-  std::string map, robot, image, camera = "omni_camera", method = "default";
+  std::string map, robot, image, log, camera = "omni_camera", method = "default";
+  std::optional<double> at;  // s, capture time of the log's frame
+  io::BagTopics topics;
   bool json = false;
 };
+
+// The image to locate from, and what to call it in messages and output.
+struct Picture {
+  Image8 image;
+  std::string name;
+  std::optional<double> captured_s;  // a log's frame
+};
+
+// The first omni frame of the log captured at or after `at` (the first, without it).
+Picture frame_of_log(const io::MissionLog& log, const LocateArgs& a) {
+  if (log.omni_images.empty())
+    throw InputError({a.log, "", ""}, log.ros2_bag ? "no omni camera images in the bag (see "
+                                                     "--omni-topic)"
+                                                   : "no omni camera images (/omni_camera/image)");
+  const auto& frames = log.omni_images;
+  auto it = frames.begin();
+  if (a.at) {
+    it = std::find_if(frames.begin(), frames.end(),
+                      [&](const auto& f) { return to_seconds(f.value.stamp) >= *a.at - 1e-9; });
+    if (it == frames.end()) {
+      std::ostringstream why;
+      why << "no omni frame captured at or after " << *a.at << " s (the log's are from "
+          << to_seconds(frames.front().value.stamp) << " to "
+          << to_seconds(frames.back().value.stamp) << " s)";
+      throw InputError({a.log, "--at", ""}, why.str());
+    }
+  }
+  std::ostringstream name;
+  name << a.log << ", omni frame captured at " << std::fixed << std::setprecision(3)
+       << to_seconds(it->value.stamp) << " s";
+  return {io::decode_image(it->value.data, name.str()), name.str(), to_seconds(it->value.stamp)};
+}
 
 std::string read_bytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -70,25 +109,40 @@ nlohmann::ordered_json to_json(const fusion::PoseHypothesis& h,
 }
 
 int run_locate(const LocateArgs& a) {
+  if (a.image.empty() == a.log.empty())
+    throw InputError({"", "--image", ""}, "give one of --image IMG and --log LOG.mcap");
+  if (!a.image.empty() && a.robot.empty())
+    throw InputError({"", "--robot", ""}, "--robot is needed with --image");
+  if (!a.image.empty() && a.at)
+    throw InputError({"", "--at", ""}, "--at picks a frame of --log, not of --image");
   const graph::LoadedMap loaded = graph::read_map(a.map);
-  const RobotDescription robot = read_robot_description(a.robot);
+  RobotDescription robot;
+  Picture picture;
+  if (!a.log.empty()) {
+    const io::MissionLog log = read_log_for_cameras(a.log, a.robot, a.topics, robot);
+    picture = frame_of_log(log, a);
+  } else {
+    robot = read_robot_description(a.robot);
+    picture = {io::decode_image(read_bytes(a.image), a.image), a.image, std::nullopt};
+  }
+  const std::string robot_source = a.robot.empty() ? a.log + " (robot.json attachment)" : a.robot;
   const CameraDescription* camera = robot.find_camera(a.camera);
-  if (!camera) throw InputError({a.robot, "cameras", "name"}, "no camera named '" + a.camera + "'");
+  if (!camera)
+    throw InputError({robot_source, "cameras", "name"}, "no camera named '" + a.camera + "'");
   if (!is_fisheye(camera->model))
-    throw InputError({a.robot, "cameras[" + a.camera + "]", "model"},
+    throw InputError({robot_source, "cameras[" + a.camera + "]", "model"},
                      "global localization needs an omnidirectional (pajdla_bakstein or "
                      "kannala_brandt) camera");
   const auto method = fusion::parse_global_method(a.method);
   if (!method)
     throw InputError({"", "--method", ""}, "'" + a.method + "' is not a method (paper, default)");
-  const Image8 image = io::decode_image(read_bytes(a.image), a.image);
   vision::OmniLampDetector detector(*camera);
   vision::OmniDetection detection;
   try {
-    detection = detector.detect(vision::ImageView::of(image));
+    detection = detector.detect(vision::ImageView::of(picture.image));
   } catch (const InputError& e) {
-    throw InputError({a.image, "", ""},
-                     e.message() + " (camera '" + a.camera + "' in " + a.robot + ")");
+    throw InputError({picture.name, "", ""},
+                     e.message() + " (camera '" + a.camera + "' in " + robot_source + ")");
   }
   const fusion::GlobalLocalizer global(loaded.map, *camera);
   const auto t0 = std::chrono::steady_clock::now();
@@ -98,7 +152,8 @@ int run_locate(const LocateArgs& a) {
 
   if (a.json) {
     nlohmann::ordered_json j;
-    j["image"] = a.image;
+    j["image"] = picture.name;
+    if (picture.captured_s) j["captured_s"] = *picture.captured_s;
     j["method"] = fusion::to_string(r.method);
     j["lamps_seen"] = detection.blobs.size();
     j["plausible"] = r.plausible;
@@ -143,8 +198,14 @@ void add_locate_command(CLI::App& app, Job& run) {
   CLI::App* cmd = app.add_subcommand(
       "locate", "Global localization from one omnidirectional image: ranked pose hypotheses");
   cmd->add_option("--map", args->map, "Map file (.geojson)")->required();
-  cmd->add_option("--robot", args->robot, "Robot description (robot.json)")->required();
-  cmd->add_option("--image", args->image, "Omnidirectional image (PNG or JPEG)")->required();
+  cmd->add_option("--robot", args->robot,
+                  "Robot description (robot.json); with --log, default: the log's attachment");
+  cmd->add_option("--image", args->image, "Omnidirectional image (PNG or JPEG)");
+  cmd->add_option("--log", args->log,
+                  "Mission log or ROS 2 bag (MCAP): locate from one of its omni frames");
+  cmd->add_option("--at", args->at,
+                  "With --log: the first omni frame captured at or after this time (s)");
+  add_bag_topic_options(*cmd, args->topics);
   cmd->add_option("--camera", args->camera, "Camera of robot.json that took it")
       ->capture_default_str();
   cmd->add_option("--method", args->method,

@@ -29,7 +29,7 @@ void add_map_survey_command(CLI::App& map, Job& run);  // map survey (under `map
 void add_route_command(CLI::App& app, Job& run);
 void add_sim_command(CLI::App& app, Job& run);
 void add_locate_command(CLI::App& app, Job& run);
-void add_run_commands(CLI::App& app, Job& run);  // run, replay
+void add_run_commands(CLI::App& app, Job& run);   // run, replay
 void add_robot_command(CLI::App& app, Job& run);  // robot import
 void add_node_command(CLI::App& app, Job& run);   // node (ROS 2 over DDS)
 
@@ -55,8 +55,14 @@ RobotDescription robot_for_log(const io::MissionLog& log, const std::string& log
 
 // --ceiling-topic, --omni-topic and --odometry-topic: which topics of a ROS 2 bag are the inputs.
 void add_bag_topic_options(CLI::App& command, io::BagTopics& topics);
-// A mission log or ROS 2 bag and the robot for it (robot_for_log). A bag's odometry becomes the
-// wheel travel of the robot's semi-axis, and how its topics were taken is said on stderr.
+// A mission log or ROS 2 bag for its camera frames, and the robot for it (robot_for_log): a
+// bag's camera mounts from its transforms, and how its topics were taken said on stderr.
+io::MissionLog read_log_for_cameras(const std::string& log_path, const std::string& robot_path,
+                                    const io::BagTopics& topics, RobotDescription& robot,
+                                    std::string* robot_text = nullptr);
+// The same with the wheels: a mission log or ROS 2 bag and the robot for it (robot_for_log). A
+// bag's odometry becomes the wheel travel of the robot's semi-axis, and how its topics were taken
+// is said on stderr.
 io::MissionLog read_log_for_robot(const std::string& log_path, const std::string& robot_path,
                                   const io::BagTopics& topics, RobotDescription& robot,
                                   std::string* robot_text = nullptr);

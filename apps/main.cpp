@@ -130,13 +130,23 @@ void mounts_from_tf(const io::MissionLog& log, const std::string& log_path, Robo
 
 }  // namespace
 
-io::MissionLog read_log_for_robot(const std::string& log_path, const std::string& robot_path,
-                                  const io::BagTopics& topics, RobotDescription& robot,
-                                  std::string* robot_text) {
+io::MissionLog read_log_for_cameras(const std::string& log_path, const std::string& robot_path,
+                                    const io::BagTopics& topics, RobotDescription& robot,
+                                    std::string* robot_text) {
   io::MissionLog log = io::read_mission_log(log_path, topics);
   robot = robot_for_log(log, log_path, robot_path, robot_text);
   if (log.ros2_bag) {
     for (const auto& n : log.notes) diagnostic("note", log_path + ": " + n);
+    mounts_from_tf(log, log_path, robot, robot_text);
+  }
+  return log;
+}
+
+io::MissionLog read_log_for_robot(const std::string& log_path, const std::string& robot_path,
+                                  const io::BagTopics& topics, RobotDescription& robot,
+                                  std::string* robot_text) {
+  io::MissionLog log = read_log_for_cameras(log_path, robot_path, topics, robot, robot_text);
+  if (log.ros2_bag) {
     io::wheels_from_odometry(log, robot.semi_axis);
     if (log.wheels.empty() && !log.wheel_joints.empty()) {
       if (!(topics.wheel_radius > 0))
@@ -145,7 +155,6 @@ io::MissionLog read_log_for_robot(const std::string& log_path, const std::string
                          "(sensor_msgs/msg/JointState): give --wheel-radius");
       io::wheels_from_joints(log, topics.wheel_radius);
     }
-    mounts_from_tf(log, log_path, robot, robot_text);
   }
   return log;
 }

@@ -7,8 +7,10 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "cdr_writer.hpp"
 #include "cli_support.hpp"
 #include "lampnav/core/robot_description.hpp"
+#include "lampnav/io/mcap.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav_test.hpp"
 
@@ -242,6 +244,68 @@ TEST(Cli, LocateSaysWhyWhenThereIsNoPoseOrTheInputIsBad) {
   EXPECT_EQ(nocam.status, 2);
   EXPECT_THAT(nocam.err, HasSubstr("no camera named 'nope'"));
   for (const auto& f : {dark, small, text}) std::filesystem::remove(f);
+}
+
+// locate --log: an omni frame of a mission log or of a ROS 2 bag, picked by its capture time,
+// gives what the same image gives as a file; the robot comes from the log when not given.
+TEST(Cli, LocateFromAFrameOfALogOrABag) {
+  const std::string fixture = src("tests/fixtures/images/domus_omni.png");
+  const std::string png = test::slurp(test::source_path("tests/fixtures/images/domus_omni.png"));
+  const std::string dark = io::encode_png(Image8(1024, 1024, 6));
+  const std::string robot_text = test::slurp(test::source_path("maps/robots/pioneer.json"));
+  auto at = [](double s) { return Stamp(std::chrono::milliseconds(std::lround(s * 1000))); };
+  const std::string log = test::temp_path("locate_log.mcap");
+  {
+    io::MissionLogWriter w(log);
+    w.attach_robot(robot_text);
+    w.write_image(at(1.3), io::ImageFrame{at(1.0), "omni_camera", "png", dark});
+    w.write_image(at(2.3), io::ImageFrame{at(2.0), "omni_camera", "png", png});
+    w.close();
+  }
+  const std::string bag = test::temp_path("locate_bag.mcap");
+  {
+    io::McapWriter w(bag, {"ros2"});
+    const auto image = w.add_schema("sensor_msgs/msg/CompressedImage", "ros2msg",
+                                    "std_msgs/Header header\nstring format\nuint8[] data\n");
+    const auto omni = w.add_channel(image, "/fisheye/image_raw/compressed", "cdr");
+    w.write(omni, 2'300'000'000, 2'300'000'000,
+            test::compressed_image_cdr(2'000'000'000, "omni_optical", "png", png));
+    w.close();
+  }
+  const std::string map = " --map " + src("maps/domus_museum.geojson");
+  const Result file = run(locate_args(fixture) + " --json");
+  ASSERT_EQ(file.status, 0) << file.err;
+  const auto want = nlohmann::json::parse(file.out)["hypotheses"];
+  for (const std::string& input : {log, bag}) {
+    SCOPED_TRACE(input);
+    const Result r = run("locate" + map + " --log " + input + " --robot " +
+                         src("maps/robots/pioneer.json") + " --at 1.5 --json");
+    ASSERT_EQ(r.status, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_DOUBLE_EQ(j["captured_s"].get<double>(), 2.0);
+    EXPECT_THAT(j["image"].get<std::string>(), HasSubstr("omni frame captured at 2.000 s"));
+    ASSERT_EQ(j["hypotheses"].size(), want.size());
+    for (std::size_t k = 0; k < want.size(); ++k)
+      for (const char* v : {"x", "y", "yaw_deg", "weight"})
+        EXPECT_EQ(j["hypotheses"][k][v], want[k][v]) << k << " " << v;
+  }
+  // The log's own robot.json when --robot is not given; its first frame (dark) without --at.
+  const Result first = run("locate" + map + " --log " + log);
+  EXPECT_EQ(first.status, 1);
+  EXPECT_THAT(first.err, HasSubstr("no lamp in the image"));
+  // Bad requests: exit 2, saying what is wrong.
+  const Result late = run("locate" + map + " --log " + log + " --at 9");
+  EXPECT_EQ(late.status, 2);
+  EXPECT_THAT(late.err, HasSubstr("no omni frame captured at or after 9 s"));
+  EXPECT_THAT(late.err, HasSubstr("from 1 to 2 s"));
+  const Result both = run(locate_args(fixture) + " --log " + log);
+  EXPECT_EQ(both.status, 2);
+  EXPECT_THAT(both.err, HasSubstr("give one of --image IMG and --log LOG.mcap"));
+  const Result no_robot = run("locate" + map + " --log " + bag);
+  EXPECT_EQ(no_robot.status, 2);
+  EXPECT_THAT(no_robot.err, HasSubstr("give --robot"));
+  std::filesystem::remove(log);
+  std::filesystem::remove(bag);
 }
 
 }  // namespace
