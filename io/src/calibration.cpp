@@ -203,9 +203,13 @@ std::vector<ImportedCamera> read_calibration(const std::string& path) {
 
 std::vector<ImportedCamera> parse_calibration(const std::string& data, const std::string& path) {
   Node root;
-  const bool opencv = data.rfind("%YAML:1.", 0) == 0 ||
-                      (data.find("<?xml") != std::string::npos && data.find("<?xml") < 16);
-  if (opencv) {
+  // OpenCV's YAML is YAML but for its first line's directive ("%YAML:1.0", not YAML's
+  // "%YAML 1.0"): read by yaml-cpp with that line made a comment (line numbers kept), like the
+  // other YAML files. OpenCV's own YAML parser is not used: a fuzzer found a 791-byte file on
+  // which it never returns (OpenCV 4.6). Its XML is read by OpenCV.
+  const bool opencv_yaml = data.rfind("%YAML:1.", 0) == 0;
+  const bool opencv_xml = data.find("<?xml") != std::string::npos && data.find("<?xml") < 16;
+  if (opencv_xml) {
     try {
       cv::FileStorage fs(data, cv::FileStorage::READ | cv::FileStorage::MEMORY);
       if (!fs.isOpened()) throw InputError({path, "", ""}, "not a YAML or XML calibration file");
@@ -219,7 +223,7 @@ std::vector<ImportedCamera> parse_calibration(const std::string& data, const std
     }
   } else {
     try {
-      root = from_yaml(YAML::Load(data));
+      root = from_yaml(YAML::Load(opencv_yaml ? "#" + data : data));
     } catch (const YAML::Exception& e) {
       throw InputError({path, "line " + std::to_string(e.mark.line + 1), ""},
                        "not a YAML or XML calibration file: " + e.msg);
