@@ -14,6 +14,8 @@ packages=(
   libceres-dev
   # YAML calibration files of ROS and Kalibr (io/, robot import), as ROS reads them
   libyaml-cpp-dev
+  # OpenCV's XML calibration files (io/), read by the XML parser ROS 2 itself uses
+  libtinyxml2-dev
   # the ROS 2 wire (ros/, lampnav node): eProsima Fast DDS, ROS 2's default DDS
   libfastrtps-dev libfastcdr-dev
   # tests and benchmarks; Chromium opens the report headless in a test

@@ -1,10 +1,11 @@
 #include "lampnav/io/calibration.hpp"
 
+#include <tinyxml2.h>
 #include <yaml-cpp/yaml.h>
 
+#include <cctype>
 #include <cmath>
 #include <map>
-#include <opencv2/core.hpp>
 #include <sstream>
 
 #include "lampnav/core/error.hpp"
@@ -14,9 +15,10 @@ namespace lampnav::io {
 
 namespace {
 
-// A parsed file as a plain tree, whichever parser read it: yaml-cpp for the YAML of ROS and Kalibr
-// (block sequences under a key at its own indentation, which OpenCV's reader refuses), OpenCV's
-// cv::FileStorage for OpenCV's own XML and "%YAML:1.0" files (its !!opencv-matrix).
+// A parsed file as a plain tree, whichever parser read it: yaml-cpp for YAML (ROS, Kalibr and
+// OpenCV's "%YAML:1.0" files with their !!opencv-matrix), tinyxml2 for OpenCV's XML. OpenCV's own
+// cv::FileStorage is not used on files from outside: fuzzing found a 791-byte YAML file on which
+// it never returns and a 408-byte XML file on which it reads address 0 (OpenCV 4.6).
 struct Node {
   enum Kind { none, scalar, list, map } kind = none;
   std::string text;  // a scalar as written
@@ -45,24 +47,38 @@ Node from_yaml(const YAML::Node& y) {
   return n;
 }
 
-Node from_opencv(const cv::FileNode& f) {
+// OpenCV's XML (cv::FileStorage's format): an element holding elements is a map of them by name,
+// or a list when they are all named "_"; an element holding text is a value, or a list of values
+// when the text holds several separated by spaces (a matrix's data); a quoted text is one value.
+Node from_xml(const tinyxml2::XMLElement& e) {
   Node n;
-  if (f.isInt() || f.isReal()) {
-    n.kind = Node::scalar;
-    std::ostringstream s;
-    s.precision(17);
-    s << static_cast<double>(f);
-    n.text = s.str();
-  } else if (f.isString()) {
-    n.kind = Node::scalar;
-    n.text = static_cast<std::string>(f);
-  } else if (f.isSeq()) {
-    n.kind = Node::list;
-    for (const auto& item : f) n.items.push_back(from_opencv(item));
-  } else if (f.isMap()) {
-    n.kind = Node::map;
-    for (const auto& item : f) n.keys[item.name()] = from_opencv(item);
+  const tinyxml2::XMLElement* child = e.FirstChildElement();
+  if (child) {
+    bool all_unnamed = true;
+    for (auto* c = child; c; c = c->NextSiblingElement())
+      all_unnamed = all_unnamed && std::string(c->Name()) == "_";
+    n.kind = all_unnamed ? Node::list : Node::map;
+    for (auto* c = child; c; c = c->NextSiblingElement()) {
+      if (all_unnamed)
+        n.items.push_back(from_xml(*c));
+      else
+        n.keys[c->Name()] = from_xml(*c);
+    }
+    return n;
   }
+  const std::string text = e.GetText() ? e.GetText() : "";
+  const auto first = text.find_first_not_of(" \t\r\n");
+  if (first == std::string::npos) return n;  // an empty element: nothing
+  const auto last = text.find_last_not_of(" \t\r\n");
+  if (text[first] == '"' && last > first && text[last] == '"') {
+    n.kind = Node::scalar;
+    n.text = text.substr(first + 1, last - first - 1);
+    return n;
+  }
+  std::istringstream words(text);
+  for (std::string word; words >> word;) n.items.push_back(Node{Node::scalar, word, {}, {}});
+  if (n.items.size() == 1) return n.items.front();
+  n.kind = Node::list;
   return n;
 }
 
@@ -205,22 +221,24 @@ std::vector<ImportedCamera> parse_calibration(const std::string& data, const std
   Node root;
   // OpenCV's YAML is YAML but for its first line's directive ("%YAML:1.0", not YAML's
   // "%YAML 1.0"): read by yaml-cpp with that line made a comment (line numbers kept), like the
-  // other YAML files. OpenCV's own YAML parser is not used: a fuzzer found a 791-byte file on
-  // which it never returns (OpenCV 4.6). Its XML is read by OpenCV.
+  // other YAML files.
   const bool opencv_yaml = data.rfind("%YAML:1.", 0) == 0;
-  const bool opencv_xml = data.find("<?xml") != std::string::npos && data.find("<?xml") < 16;
-  if (opencv_xml) {
-    try {
-      cv::FileStorage fs(data, cv::FileStorage::READ | cv::FileStorage::MEMORY);
-      if (!fs.isOpened()) throw InputError({path, "", ""}, "not a YAML or XML calibration file");
-      root = from_opencv(fs.root());
-    } catch (const cv::Exception& e) {
-      throw InputError({path, "", ""}, "not a YAML or XML calibration file: " + e.err);
-    } catch (const std::exception& e) {
-      // OpenCV's parser lets through what its own allocations throw on a malformed file.
-      throw InputError({path, "", ""},
-                       std::string("not a YAML or XML calibration file (") + e.what() + ")");
+  const auto xml_at = data.find("<?xml");
+  if (xml_at != std::string::npos && xml_at < 16) {
+    tinyxml2::XMLDocument doc;
+    if (doc.Parse(data.data(), data.size()) != tinyxml2::XML_SUCCESS) {
+      // "XML_ERROR_PARSING_ATTRIBUTE" said as "error parsing attribute".
+      std::string what = doc.ErrorName();
+      if (what.rfind("XML_", 0) == 0) what.erase(0, 4);
+      for (char& c : what) c = c == '_' ? ' ' : char(std::tolower(static_cast<unsigned char>(c)));
+      throw InputError({path, "line " + std::to_string(doc.ErrorLineNum()), ""},
+                       "not a YAML or XML calibration file: XML " + what);
     }
+    const tinyxml2::XMLElement* storage = doc.RootElement();
+    if (!storage || std::string(storage->Name()) != "opencv_storage")
+      throw InputError({path, "", ""}, "an XML calibration file is OpenCV's <opencv_storage>");
+    root = from_xml(*storage);
+    if (root.kind == Node::none) root.kind = Node::map;  // <opencv_storage/>: no keys
   } else {
     try {
       root = from_yaml(YAML::Load(opencv_yaml ? "#" + data : data));

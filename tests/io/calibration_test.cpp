@@ -244,6 +244,26 @@ TEST(Calibration, WhatCannotBeReadIsRefusedNamingFileAndField) {
       "intrinsics", "[fu, fv, pu, pv]");
   refused("other.yaml", "name: something\nsize: 3\n", "", "not a calibration lampnav reads");
   refused("garbage.yaml", "{{{{ not yaml", "", "not a YAML or XML calibration file");
+  // Found by the fuzzer: an attribute without its opening quote made OpenCV's XML parser read
+  // address 0; the XML is now read by tinyxml2, and the line is named.
+  const std::string xml_matrix =
+      "<rows>3</rows><cols>3</cols><dt>d</dt><data>300. 0. 160. 0. 300. 120. 0. 0. "
+      "1.</data></camera_matrix>\n";
+  refused("unquoted.xml",
+          "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>320</image_width>\n"
+          "<camera_matrix type_id=ncv-matrix\">" +
+              xml_matrix + "</opencv_storage>\n",
+          "", "line 4");
+  refused("root.xml", "<?xml version=\"1.0\"?>\n<calibration><a>1</a></calibration>\n", "",
+          "<opencv_storage>");
+  refused("xml_rows.xml",
+          "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>320</image_width>\n"
+          "<image_height>240</image_height>\n<camera_matrix type_id=\"opencv-matrix\">"
+          "<rows>3</rows><cols>3</cols><dt>d</dt><data>300. 0. 160. 0. 300. 120.</data>"
+          "</camera_matrix>\n<distortion_coefficients type_id=\"opencv-matrix\"><rows>4</rows>"
+          "<cols>1</cols><dt>d</dt><data>0 0 0 0</data></distortion_coefficients>\n"
+          "</opencv_storage>\n",
+          "camera_matrix", "data holds 6 numbers");
 }
 
 }  // namespace
