@@ -6,7 +6,9 @@
 //    relocalized to the true place, wrong fixes (target: 100, 100, 0), latency in s and m;
 //  - unknown starts: wrong fixes (target 0), latency;
 //  - the localizer's time per camera frame while it does not know, with the live hypotheses
-//    it weighs (target: 2 ms a frame with 100 hypotheses).
+//    it weighs (target: 2 ms a frame with 100 hypotheses); the 100-node kidnaps again with the
+//    hypotheses weighed and the images searched on the calling thread only (the same results,
+//    one core's time).
 // Each runs once (Iterations(1)); the figures are counters.
 
 #include <benchmark/benchmark.h>
@@ -55,11 +57,12 @@ void report(benchmark::State& state, const test::BatteryFigures& f) {
 
 // range(0) nodes, range(1) episodes, each `episode(battery, seed)`.
 template <class Episode>
-void run_battery(benchmark::State& state, std::uint64_t first_seed, Episode episode) {
+void run_battery(benchmark::State& state, std::uint64_t first_seed, Episode episode,
+                 const fusion::LocalizerOptions& localizer = {}) {
   const World w(static_cast<int>(state.range(0)));
   test::BatteryFigures f;
   for (auto _ : state) {
-    test::Battery battery(w.map, w.robot);
+    test::Battery battery(w.map, w.robot, {}, localizer);
     std::vector<test::EpisodeResult> rs;
     for (int k = 1; k <= state.range(1); ++k) rs.push_back(episode(battery, first_seed + k));
     f = test::figures(rs);
@@ -74,6 +77,19 @@ BENCHMARK(BM_KidnapBattery)
     ->Args({10, 100})
     ->Args({100, 100})
     ->Args({1000, 10})  // about a minute an episode on this machine: see docs/hypotheses.md
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+
+void BM_KidnapBatteryOneCore(benchmark::State& state) {
+  fusion::LocalizerOptions one_core;
+  one_core.hypotheses.weigh_in_parallel = false;
+  one_core.global.parallel = false;
+  run_battery(
+      state, 5000, [](test::Battery& b, std::uint64_t seed) { return b.kidnap(seed); }, one_core);
+}
+BENCHMARK(BM_KidnapBatteryOneCore)
+    ->Args({100, 100})
     ->Unit(benchmark::kSecond)
     ->Iterations(1)
     ->UseRealTime();

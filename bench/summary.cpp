@@ -246,6 +246,17 @@ void add_battery(const std::string& what, const std::string& bench, bool kidnaps
          << c["unsure_mean_hypotheses"].get<double>() << " hypotheses on average)";
     add(name.str(), c["unsure_us_per_frame"].get<double>(), "", std::nullopt, 2000.0, std::nullopt);
   }
+  // The target's own case: frames that found 50 to 200 live hypotheses ("100").
+  if (it != results.end() && it->second.raw.contains("frames_50_200_hypotheses") &&
+      it->second.raw["frames_50_200_hypotheses"].get<double>() > 0) {
+    const Json& c = it->second.raw;
+    std::ostringstream name;
+    name << std::setprecision(3) << "  localizer per frame with 50 to 200 hypotheses ("
+         << c["mean_hypotheses_of_those"].get<double>() << " on average, "
+         << c["frames_50_200_hypotheses"].get<double>() << " frames)";
+    add(name.str(), c["us_per_frame_50_200_hypotheses"].get<double>(), "", std::nullopt, 2000.0,
+        std::nullopt);
+  }
 }
 
 // How a cost grows with the building: the exponent of n between 100 and 1,000 nodes.
@@ -349,6 +360,9 @@ int main(int argc, char** argv) {
   for (const auto& [n, count] : {std::pair{"10", "100"}, {"100", "100"}, {"1000", "10"}})
     add_battery(std::string("kidnaps (") + count + "), " + n + "-node building",
                 std::string("BM_KidnapBattery/") + n + "/" + count, true);
+  add("  the same 100-node kidnaps, hypotheses weighed on one core: per frame with 50 to 200",
+      counter("BM_KidnapBatteryOneCore/100/100", "us_per_frame_50_200_hypotheses", 1), "",
+      std::nullopt, std::nullopt, std::nullopt);
   for (const auto& [n, count] : {std::pair{"10", "20"}, {"100", "20"}, {"1000", "3"}})
     add_battery(std::string("unknown starts (") + count + "), " + n + "-node building",
                 std::string("BM_UnknownStartBattery/") + n + "/" + count, false);

@@ -4,6 +4,7 @@
 // `default`) and paper_method.cpp (method `paper`, Alg. 3).
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <unordered_map>
@@ -132,6 +133,17 @@ struct GlobalLocalizer::Impl {
        const GlobalLocalizerOptions& opt);
 
   const graph::Node* node_of(const Pose2& p) const { return map->node_containing(p.translation()); }
+  // Hypotheses refined outside every node's region dropped (restrict_to_graph), the rest in order.
+  void drop_outside_graph(std::vector<PoseHypothesis>& hs) const {
+    if (!o.pairs.restrict_to_graph || !has_regions) return;
+    hs.erase(std::remove_if(hs.begin(), hs.end(),
+                            [&](const PoseHypothesis& h) { return !node_of(h.pose); }),
+             hs.end());
+  }
+  // Batches of more than `n` costly items go on every core, unless the options say one.
+  std::size_t serial_up_to(std::size_t n) const {
+    return o.parallel ? n : std::numeric_limits<std::size_t>::max();
+  }
 
   // ---------------------------------------------------------------------------------------
   // Scoring a pose. The lamp in the camera frame from a robot pose, the base tilted by the floor

@@ -4,9 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <unordered_map>
 
 #include "global_localizer_impl.hpp"
+#include "lampnav/core/parallel.hpp"
 #include "spurious_blobs.hpp"
 
 namespace lampnav::fusion {
@@ -159,12 +161,11 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
   std::stable_sort(scored.begin(), scored.end(),
                    [](const auto& a, const auto& b) { return a.first < b.first; });
   if (scored.size() > std::size_t(q.refined)) scored.resize(q.refined);
-  std::vector<PoseHypothesis> refined;
-  for (const auto& [cost, pose] : scored) {
-    PoseHypothesis h = refine(pose, 0.3, 3 * kDeg, blobs);
-    if (q.restrict_to_graph && has_regions && !node_of(h.pose)) continue;
-    refined.push_back(std::move(h));
-  }
+  std::vector<PoseHypothesis> refined(scored.size());
+  for_each_costly_index(scored.size(), serial_up_to(2), [&](std::size_t k) {
+    refined[k] = refine(scored[k].second, 0.3, 3 * kDeg, blobs);
+  });
+  drop_outside_graph(refined);
   finish(out, refined, d, q, max_hypotheses);
   out.complete = !truncated && out.plausible < max_hypotheses;
   if (truncated && out.found()) {
@@ -208,9 +209,12 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   std::vector<std::pair<std::int64_t, Pose2>> poses(cells.begin(), cells.end());
   std::sort(poses.begin(), poses.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
-  std::vector<std::pair<double, Pose2>> scored;
-  for (const auto& [key, pose] : poses) {
-    if (q.restrict_to_graph && has_regions && !node_of(pose)) continue;
+  // Each pose screened alone (on every core), kept in the order of its cell.
+  const double not_scored = std::numeric_limits<double>::quiet_NaN();
+  std::vector<double> screened(poses.size(), not_scored);
+  for_each_costly_index(poses.size(), serial_up_to(16), [&](std::size_t i) {
+    const Pose2& pose = poses[i].second;
+    if (q.restrict_to_graph && has_regions && !node_of(pose)) return;
     int misses = 0;
     const double c = std::cos(pose.yaw()), s = std::sin(pose.yaw());
     for (std::size_t j = 0; j < ns && misses <= 1; ++j) {
@@ -227,11 +231,13 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
       }
       if (!on_lamp) ++misses;
     }
-    if (misses > 1) continue;
+    if (misses > 1) return;
     // Screened on the cone of the seeds (a few lamps each), the survivors scored in full.
-    scored.emplace_back(
-        evaluate(pose, {}, 0.3, 3 * kDeg, q.tilt_sigma_deg * kDeg, near, screen).cost, pose);
-  }
+    screened[i] = evaluate(pose, {}, 0.3, 3 * kDeg, q.tilt_sigma_deg * kDeg, near, screen).cost;
+  });
+  std::vector<std::pair<double, Pose2>> scored;
+  for (std::size_t i = 0; i < poses.size(); ++i)
+    if (!std::isnan(screened[i])) scored.emplace_back(screened[i], poses[i].second);
   out.merit_evaluations = static_cast<int>(scored.size());
   if (scored.empty()) {
     out.why = "no place of the map has lamps where the " + std::to_string(ns) +
@@ -245,24 +251,30 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   // pose within `margin` of the best must fit under the cap for the search to be complete.
   const double reach = scored.front().first + margin + 30.0;
   const std::size_t limit = 4 * std::size_t(cap);
-  std::vector<PoseHypothesis> refined;
-  std::size_t within = 0;
-  for (const auto& [cost, pose] : scored) {
-    if (cost > reach) break;
-    if (++within > limit) break;
-    // One level round: enough to rank the candidates; the hypothesis set refines in full.
-    PoseHypothesis h = refine(pose, 0.3, 3 * kDeg, blobs, 1, false);
-    if (q.restrict_to_graph && has_regions && !node_of(h.pose)) continue;
-    refined.push_back(std::move(h));
-  }
+  std::size_t in_reach = 0;
+  while (in_reach < scored.size() && scored[in_reach].first <= reach) ++in_reach;
+  const std::size_t within = std::min(in_reach, limit + 1);  // over the limit: incomplete
+  // One level round each: enough to rank the candidates; the hypothesis set refines in full.
+  std::vector<PoseHypothesis> refined(std::min(in_reach, limit));
+  for_each_costly_index(refined.size(), serial_up_to(2), [&](std::size_t k) {
+    refined[k] = refine(scored[k].second, 0.3, 3 * kDeg, blobs, 1, false);
+  });
+  drop_outside_graph(refined);
   // The plausible ones (within the ambiguity margin of the best, 32 at most) refined in full,
   // with the floor's tilt: one of them may be published from this image alone.
   std::stable_sort(
       refined.begin(), refined.end(),
       [](const PoseHypothesis& a, const PoseHypothesis& b) { return a.score < b.score; });
-  for (std::size_t k = 0; k < refined.size() && k < 32; ++k) {
-    if (refined[k].score > refined.front().score + q.ambiguity_margin) break;
-    refined[k] = refine(refined[k].pose, 0.1, 1 * kDeg, blobs);
+  if (!refined.empty()) {
+    // The best first: the others are judged against its refined score.
+    refined.front() = refine(refined.front().pose, 0.1, 1 * kDeg, blobs);
+    std::size_t plausible = 1;
+    while (plausible < refined.size() && plausible < 32 &&
+           refined[plausible].score <= refined.front().score + q.ambiguity_margin)
+      ++plausible;
+    for_each_costly_index(plausible - 1, serial_up_to(1), [&](std::size_t k) {
+      refined[k + 1] = refine(refined[k + 1].pose, 0.1, 1 * kDeg, blobs);
+    });
   }
   finish(out, refined, d, q, static_cast<int>(limit));
   std::size_t kept = 0;

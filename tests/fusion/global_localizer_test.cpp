@@ -313,6 +313,45 @@ TEST(GlobalLocalizer, GeneratedBuildingFindsOrSaysAmbiguous) {
   std::cout << found << " of " << views << " views found, " << ambiguous << " ambiguous\n";
 }
 
+// Candidates are scored and refined on every core: on one core, locate() and enumerate() give
+// the same hypotheses to the last bit (a 100-node building, where enumerations refine hundreds).
+TEST(GlobalLocalizer, SearchingOnEveryCoreChangesNothing) {
+  const Museum m;
+  const graph::TopologicalMap map = generated_map(100);
+  std::vector<const graph::Node*> corridors;
+  for (const auto& n : map.nodes())
+    if (n.axis) corridors.push_back(&n);
+  GlobalLocalizerOptions one_core;
+  one_core.parallel = false;
+  const GlobalLocalizer spread(map, m.cam()), alone(map, m.cam(), one_core);
+  auto same = [](const GlobalLocalization& a, const GlobalLocalization& b, int view) {
+    EXPECT_EQ(a.complete, b.complete) << view;
+    EXPECT_EQ(a.plausible, b.plausible) << view;
+    EXPECT_EQ(a.merit_evaluations, b.merit_evaluations) << view;
+    EXPECT_EQ(a.why, b.why) << view;
+    ASSERT_EQ(a.hypotheses.size(), b.hypotheses.size()) << view;
+    for (std::size_t k = 0; k < a.hypotheses.size(); ++k) {
+      EXPECT_EQ(a.hypotheses[k].pose.x(), b.hypotheses[k].pose.x()) << view << " " << k;
+      EXPECT_EQ(a.hypotheses[k].pose.y(), b.hypotheses[k].pose.y()) << view << " " << k;
+      EXPECT_EQ(a.hypotheses[k].pose.yaw(), b.hypotheses[k].pose.yaw()) << view << " " << k;
+      EXPECT_EQ(a.hypotheses[k].score, b.hypotheses[k].score) << view << " " << k;
+    }
+  };
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::size_t most = 0;
+  for (int view = 0; view < 6; ++view) {
+    const graph::Node& c = *corridors[rng() % corridors.size()];
+    const Pose2 truth(c.axis->point_at((0.1 + 0.8 * u(rng)) * c.axis->length()), 2 * M_PI * u(rng));
+    const auto d = render_and_detect(m.cam(), map, truth, rng());
+    same(spread.locate(d), alone.locate(d), view);
+    const GlobalLocalization e = spread.enumerate(d, 512, 9.2);
+    most = std::max(most, e.hypotheses.size());
+    same(e, alone.enumerate(d, 512, 9.2), view);
+  }
+  EXPECT_GE(most, 8u) << "no enumeration had enough candidates to spread";
+}
+
 // A corner seen from under its lamp, and a crossing put in its place at every heading: the
 // crossing has two rows of lamps the corner has not, seen far off-axis where the rows' lamps
 // crowd each other in the image. Crowded lamps are still expected under some blob: the crossing

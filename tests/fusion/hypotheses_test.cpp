@@ -4,6 +4,7 @@
 // frames late as on the robot. The rule under test: never a pose published as certain that is
 // wrong; "it is one of these" is always allowed.
 
+#include <algorithm>
 #include <cstdlib>
 #include <iostream>
 
@@ -73,6 +74,46 @@ TEST(Hypotheses, GridOfficeKidnapsIntoLookAlikeCorridors) {
     EXPECT_EQ(r.wrong_fixes, 0);
     EXPECT_TRUE(r.detected);
     EXPECT_TRUE(r.fix_correct);
+  }
+}
+
+// The hypotheses of a frame are weighed, and an image's candidates searched, on every core: the
+// same kidnaps on one core give every hypothesis of every frame to the last bit.
+TEST(Hypotheses, WeighingOnEveryCoreChangesNothing) {
+  const Building w(grid_office());
+  struct Run {
+    std::vector<double> trace;  // per frame: count, then each hypothesis's x, y, yaw, log weight
+    std::vector<test::EpisodeResult> rs;
+  };
+  auto run = [&](bool parallel) {
+    Run out;
+    test::BatteryOptions bo;
+    bo.oracle = false;
+    bo.trace = [&out](double, const Pose2&, const Localizer& loc) {
+      const auto& hs = loc.hypotheses().hypotheses();
+      out.trace.push_back(static_cast<double>(hs.size()));
+      for (const auto& h : hs)
+        out.trace.insert(out.trace.end(), {h.pose.x(), h.pose.y(), h.pose.yaw(), h.log_weight});
+    };
+    LocalizerOptions lo;
+    lo.hypotheses.weigh_in_parallel = parallel;
+    lo.global.parallel = parallel;
+    test::Battery battery(w.map, w.robot, bo, lo);
+    for (std::uint64_t seed = 1; seed <= 3; ++seed) out.rs.push_back(battery.kidnap(seed));
+    return out;
+  };
+  const Run serial = run(false), parallel = run(true);
+  std::size_t most = 0;
+  for (const auto& r : serial.rs) most = std::max(most, r.max_hypotheses);
+  std::cout << serial.trace.size() << " values traced, at most " << most << " hypotheses\n";
+  EXPECT_GE(most, 8u) << "the kidnaps never weighed enough hypotheses to spread them";
+  ASSERT_EQ(serial.trace.size(), parallel.trace.size());
+  for (std::size_t k = 0; k < serial.trace.size(); ++k)
+    ASSERT_EQ(serial.trace[k], parallel.trace[k]) << "at trace value " << k;
+  for (std::size_t e = 0; e < serial.rs.size(); ++e) {
+    EXPECT_EQ(serial.rs[e].fixed, parallel.rs[e].fixed);
+    EXPECT_EQ(serial.rs[e].latency_s, parallel.rs[e].latency_s);
+    EXPECT_EQ(serial.rs[e].wrong_fixes, parallel.rs[e].wrong_fixes);
   }
 }
 

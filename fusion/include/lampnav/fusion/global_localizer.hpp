@@ -75,7 +75,10 @@ struct GlobalLocalizerOptions {
   PaperMethodOptions paper;
   LampPairOptions pairs;
   int max_hypotheses = 5;  // returned, best first
-  void validate() const;   // throws InputError naming the field
+  // The candidates of an image scored and refined on every core (up to four), or on the calling
+  // thread only; the results are the same to the last bit.
+  bool parallel = true;
+  void validate() const;  // throws InputError naming the field
 };
 
 struct LampMatch {

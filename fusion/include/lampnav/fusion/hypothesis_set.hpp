@@ -61,7 +61,10 @@ struct HypothesisSetOptions {
   double birth_sigma_m = 0.1, birth_sigma_deg = 1.5;  // a hypothesis born from one image
   double ceiling_miss_cost = 4.6;                     // -2 ln 0.1, a lamp in clear view not seen
   double ceiling_spurious_cost = 6.0;                 // a lamp in full view no map lamp explains
-  void validate() const;                              // throws InputError naming the field
+  // A frame's hypotheses weighed on every core (up to four), or on the calling thread only; the
+  // results are the same to the last bit.
+  bool weigh_in_parallel = true;
+  void validate() const;  // throws InputError naming the field
 };
 
 enum class HypothesisOrigin { omni, kept };  // born from an omni image; the tracking estimate
