@@ -1,19 +1,23 @@
 #pragma once
-// Work on every index of a batch, spread over up to four cores (small batches on this thread).
-// Results do not depend on the number of cores: each index is worked on alone, and callers keep
-// what it gives in its own slot.
+// Work on every index of a batch, spread over up to four cores. Batch jobs start threads of
+// their own (for_each_index); a frame's work goes to workers that stay (for_each_costly_index).
+// Results do not depend on the number of cores when each index is worked on alone and callers
+// keep what it gives in its own slot.
 
 #include <algorithm>
 #include <atomic>
 #include <cstddef>
+#include <functional>
 #include <thread>
 #include <vector>
 
 namespace lampnav {
 
-namespace detail {
+// fn(state, i) for every i in [0, n), with one state per worker made by make_state() on that
+// worker (for tools that are not thread-safe, a detector each). Indices are handed out in order.
+// Batches of up to 64 stay on this thread.
 template <class MakeState, class Fn>
-void for_each_index_spread(std::size_t n, std::size_t serial_up_to, MakeState& make_state, Fn& fn) {
+void for_each_index(std::size_t n, MakeState make_state, Fn fn) {
   std::atomic<std::size_t> next{0};
   auto work = [&] {
     auto state = make_state();
@@ -21,18 +25,9 @@ void for_each_index_spread(std::size_t n, std::size_t serial_up_to, MakeState& m
   };
   const unsigned cores = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
   std::vector<std::thread> pool;
-  for (unsigned k = 1; k < cores && k < n && n > serial_up_to; ++k) pool.emplace_back(work);
+  for (unsigned k = 1; k < cores && n > 64; ++k) pool.emplace_back(work);
   work();
   for (auto& t : pool) t.join();
-}
-}  // namespace detail
-
-// fn(state, i) for every i in [0, n), with one state per worker made by make_state() on that
-// worker (for tools that are not thread-safe, a detector each). Indices are handed out in order.
-// Batches of up to 64 stay on this thread.
-template <class MakeState, class Fn>
-void for_each_index(std::size_t n, MakeState make_state, Fn fn) {
-  detail::for_each_index_spread(n, 64, make_state, fn);
 }
 
 // fn(i) for every i in [0, n).
@@ -42,13 +37,19 @@ void for_each_index(std::size_t n, Fn fn) {
       n, [] { return 0; }, [&](int, std::size_t i) { fn(i); });
 }
 
-// fn(i) for every i in [0, n), for items that each take tens of microseconds or more: batches of
-// more than `serial_up_to` are spread (a thread takes some 20 us to start and join).
+namespace detail {
+void for_each_on_pool(std::size_t n, std::size_t serial_up_to,
+                      const std::function<void(std::size_t)>& fn);
+}
+
+// fn(i) for every i in [0, n), for items that each take tens of microseconds or more, a frame's
+// work at a time: batches of more than `serial_up_to` are shared with workers that stay (up to
+// three, one per other core). The caller works too, and never waits for a worker that has not
+// started; fn must be safe to call from several threads at once. An exception from fn stops the
+// batch and is thrown here once no item runs.
 template <class Fn>
 void for_each_costly_index(std::size_t n, std::size_t serial_up_to, Fn fn) {
-  auto no_state = [] { return 0; };
-  auto each = [&](int, std::size_t i) { fn(i); };
-  detail::for_each_index_spread(n, serial_up_to, no_state, each);
+  detail::for_each_on_pool(n, serial_up_to, std::function<void(std::size_t)>(std::ref(fn)));
 }
 
 }  // namespace lampnav
