@@ -318,16 +318,42 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
       }
     }
   }
-  std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
+  // One to one, nearest first: the pairs in order, each taken unless its lamp or blob is. A pair
+  // that is the first of its lamp's and of its blob's is always taken, and the pairs it shuts
+  // out are all after it: those are taken at once, and only the pairs left are sorted (most
+  // lamps have one blob near, so a few). The pairs taken are then summed in order, as before.
+  const auto before = [](const Pair& a, const Pair& b) {
     return a.cost < b.cost || (a.cost == b.cost && (a.p < b.p || (a.p == b.p && a.b < b.b)));
-  });
-  Evaluation e;
-  e.cost = 0;
+  };
+  std::vector<int> first_of_lamp(pred.size(), -1), first_of_blob(blobs.size(), -1);
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    int& fl = first_of_lamp[pairs[k].p];
+    if (fl < 0 || before(pairs[k], pairs[fl])) fl = int(k);
+    int& fb = first_of_blob[pairs[k].b];
+    if (fb < 0 || before(pairs[k], pairs[fb])) fb = int(k);
+  }
   std::vector<char> b_used(blobs.size(), 0);
-  for (const Pair& p : pairs) {
+  std::vector<Pair> taken, left;
+  for (std::size_t k = 0; k < pairs.size(); ++k)
+    if (first_of_lamp[pairs[k].p] == int(k) && first_of_blob[pairs[k].b] == int(k)) {
+      taken.push_back(pairs[k]);
+      pred[pairs[k].p].matched = true;
+      b_used[pairs[k].b] = 1;
+    }
+  for (const Pair& p : pairs)
+    if (!pred[p.p].matched && !b_used[p.b]) left.push_back(p);
+  std::sort(left.begin(), left.end(), before);
+  for (const Pair& p : left) {
     if (pred[p.p].matched || b_used[p.b]) continue;
     pred[p.p].matched = true;
     b_used[p.b] = 1;
+    taken.push_back(p);
+  }
+  std::sort(taken.begin(), taken.end(), before);
+  Evaluation e;
+  e.cost = 0;
+  e.matches.reserve(taken.size());
+  for (const Pair& p : taken) {
     e.cost += p.cost;
     e.matches.emplace_back(pred[p.p].lamp, p.b);
   }
