@@ -342,7 +342,7 @@ int main(int argc, char** argv) {
             counter("BM_OfficeMissionLog/50", "mean_error_cm", 1), "PNG",
             counter("BM_OfficeMissionLog/0", "mean_error_cm", 1), std::nullopt, 0.1, "cm");
   for (const char* n : {"10", "100", "1000"})
-    add_counter(std::string("replay of a 10-minute mission, ") + n + "-node building",
+    add_counter(std::string("replay of a 6-minute mission, ") + n + "-node building",
                 std::string("BM_ReplayBuildingMission/") + n, "realtime_factor", 50, "x real time");
   grows("replay", "BM_ReplayBuildingMission");
   add("map build from a recorded 10-minute drive (100-node building)", us("BM_MapBuildFromLog"), "",
