@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <unordered_map>
 
 #include "global_localizer_impl.hpp"
@@ -210,8 +209,8 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   std::sort(poses.begin(), poses.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
   // Each pose screened alone (on every core), kept in the order of its cell.
-  const double not_scored = std::numeric_limits<double>::quiet_NaN();
-  std::vector<double> screened(poses.size(), not_scored);
+  std::vector<double> screened(poses.size(), 0.0);
+  std::vector<char> passed(poses.size(), 0);
   for_each_costly_index(poses.size(), serial_up_to(16), [&](std::size_t i) {
     const Pose2& pose = poses[i].second;
     if (q.restrict_to_graph && has_regions && !node_of(pose)) return;
@@ -234,10 +233,11 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
     if (misses > 1) return;
     // Screened on the cone of the seeds (a few lamps each), the survivors scored in full.
     screened[i] = evaluate(pose, {}, 0.3, 3 * kDeg, q.tilt_sigma_deg * kDeg, near, screen).cost;
+    passed[i] = 1;
   });
   std::vector<std::pair<double, Pose2>> scored;
   for (std::size_t i = 0; i < poses.size(); ++i)
-    if (!std::isnan(screened[i])) scored.emplace_back(screened[i], poses[i].second);
+    if (passed[i]) scored.emplace_back(screened[i], poses[i].second);
   out.merit_evaluations = static_cast<int>(scored.size());
   if (scored.empty()) {
     out.why = "no place of the map has lamps where the " + std::to_string(ns) +
@@ -252,7 +252,7 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   const double reach = scored.front().first + margin + 30.0;
   const std::size_t limit = 4 * std::size_t(cap);
   std::size_t in_reach = 0;
-  while (in_reach < scored.size() && scored[in_reach].first <= reach) ++in_reach;
+  while (in_reach < scored.size() && !(scored[in_reach].first > reach)) ++in_reach;
   const std::size_t within = std::min(in_reach, limit + 1);  // over the limit: incomplete
   // One level round each: enough to rank the candidates; the hypothesis set refines in full.
   std::vector<PoseHypothesis> refined(std::min(in_reach, limit));
@@ -270,7 +270,7 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
     refined.front() = refine(refined.front().pose, 0.1, 1 * kDeg, blobs);
     std::size_t plausible = 1;
     while (plausible < refined.size() && plausible < 32 &&
-           refined[plausible].score <= refined.front().score + q.ambiguity_margin)
+           !(refined[plausible].score > refined.front().score + q.ambiguity_margin))
       ++plausible;
     for_each_costly_index(plausible - 1, serial_up_to(1), [&](std::size_t k) {
       refined[k + 1] = refine(refined[k + 1].pose, 0.1, 1 * kDeg, blobs);
