@@ -32,17 +32,23 @@ struct Node {
   bool empty() const { return kind == none; }
 };
 
-Node from_yaml(const YAML::Node& y) {
+// A key given twice in one map is refused, not the last taken.
+Node from_yaml(const YAML::Node& y, const std::string& path) {
   Node n;
   if (y.IsScalar()) {
     n.kind = Node::scalar;
     n.text = y.Scalar();
   } else if (y.IsSequence()) {
     n.kind = Node::list;
-    for (const auto& item : y) n.items.push_back(from_yaml(item));
+    for (const auto& item : y) n.items.push_back(from_yaml(item, path));
   } else if (y.IsMap()) {
     n.kind = Node::map;
-    for (const auto& kv : y) n.keys[kv.first.as<std::string>()] = from_yaml(kv.second);
+    for (const auto& kv : y) {
+      const std::string key = kv.first.as<std::string>();
+      if (!n.keys.emplace(key, from_yaml(kv.second, path)).second)
+        throw InputError({path, "line " + std::to_string(kv.first.Mark().line + 1), key},
+                         "given twice");
+    }
   }
   return n;
 }
@@ -50,7 +56,8 @@ Node from_yaml(const YAML::Node& y) {
 // OpenCV's XML (cv::FileStorage's format): an element holding elements is a map of them by name,
 // or a list when they are all named "_"; an element holding text is a value, or a list of values
 // when the text holds several separated by spaces (a matrix's data); a quoted text is one value.
-Node from_xml(const tinyxml2::XMLElement& e) {
+// A name given twice in one element is refused (OpenCV never writes one).
+Node from_xml(const tinyxml2::XMLElement& e, const std::string& path) {
   Node n;
   const tinyxml2::XMLElement* child = e.FirstChildElement();
   if (child) {
@@ -60,9 +67,10 @@ Node from_xml(const tinyxml2::XMLElement& e) {
     n.kind = all_unnamed ? Node::list : Node::map;
     for (auto* c = child; c; c = c->NextSiblingElement()) {
       if (all_unnamed)
-        n.items.push_back(from_xml(*c));
-      else
-        n.keys[c->Name()] = from_xml(*c);
+        n.items.push_back(from_xml(*c, path));
+      else if (!n.keys.emplace(c->Name(), from_xml(*c, path)).second)
+        throw InputError({path, "line " + std::to_string(c->GetLineNum()), c->Name()},
+                         "given twice in <" + std::string(e.Name()) + ">");
     }
     return n;
   }
@@ -237,11 +245,11 @@ std::vector<ImportedCamera> parse_calibration(const std::string& data, const std
     const tinyxml2::XMLElement* storage = doc.RootElement();
     if (!storage || std::string(storage->Name()) != "opencv_storage")
       throw InputError({path, "", ""}, "an XML calibration file is OpenCV's <opencv_storage>");
-    root = from_xml(*storage);
+    root = from_xml(*storage, path);
     if (root.kind == Node::none) root.kind = Node::map;  // <opencv_storage/>: no keys
   } else {
     try {
-      root = from_yaml(YAML::Load(opencv_yaml ? "#" + data : data));
+      root = from_yaml(YAML::Load(opencv_yaml ? "#" + data : data), path);
     } catch (const YAML::Exception& e) {
       throw InputError({path, "line " + std::to_string(e.mark.line + 1), ""},
                        "not a YAML or XML calibration file: " + e.msg);

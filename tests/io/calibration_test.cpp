@@ -254,6 +254,12 @@ TEST(Calibration, WhatCannotBeReadIsRefusedNamingFileAndField) {
           "<camera_matrix type_id=ncv-matrix\">" +
               xml_matrix + "</opencv_storage>\n",
           "", "line 4");
+  refused("twice.yaml", "image_width: 320\nimage_height: 240\nimage_width: 640\n", "image_width",
+          "line 3");
+  refused("twice.xml",
+          "<?xml version=\"1.0\"?>\n<opencv_storage>\n<image_width>320</image_width>\n"
+          "<image_width>640</image_width>\n</opencv_storage>\n",
+          "image_width", "line 4");
   refused("root.xml", "<?xml version=\"1.0\"?>\n<calibration><a>1</a></calibration>\n", "",
           "<opencv_storage>");
   refused("xml_rows.xml",
