@@ -1,11 +1,14 @@
 #include "lampnav/core/parallel.hpp"
 
+#include <algorithm>
 #include <condition_variable>
 #include <exception>
 #include <memory>
 #include <mutex>
 
 namespace lampnav::detail {
+
+unsigned cores() { return std::max(1u, std::min(4u, std::thread::hardware_concurrency())); }
 
 namespace {
 
@@ -15,8 +18,7 @@ namespace {
 class WorkerPool {
  public:
   WorkerPool() {
-    const unsigned cores = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
-    for (unsigned k = 1; k < cores; ++k) workers_.emplace_back([this] { work(); });
+    for (unsigned k = 1; k < cores(); ++k) workers_.emplace_back([this] { work(); });
   }
   ~WorkerPool() {
     {

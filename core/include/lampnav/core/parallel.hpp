@@ -4,7 +4,6 @@
 // Results do not depend on the number of cores when each index is worked on alone and callers
 // keep what it gives in its own slot.
 
-#include <algorithm>
 #include <atomic>
 #include <cstddef>
 #include <functional>
@@ -12,6 +11,13 @@
 #include <vector>
 
 namespace lampnav {
+
+namespace detail {
+// The cores a batch is spread over: this machine's, at least one and at most four.
+unsigned cores();
+void for_each_on_pool(std::size_t n, std::size_t serial_up_to,
+                      const std::function<void(std::size_t)>& fn);
+}  // namespace detail
 
 // fn(state, i) for every i in [0, n), with one state per worker made by make_state() on that
 // worker (for tools that are not thread-safe, a detector each). Indices are handed out in order.
@@ -23,9 +29,8 @@ void for_each_index(std::size_t n, MakeState make_state, Fn fn) {
     auto state = make_state();
     for (std::size_t i = next++; i < n; i = next++) fn(state, i);
   };
-  const unsigned cores = std::max(1u, std::min(4u, std::thread::hardware_concurrency()));
   std::vector<std::thread> pool;
-  for (unsigned k = 1; k < cores && n > 64; ++k) pool.emplace_back(work);
+  for (unsigned k = 1; k < detail::cores() && n > 64; ++k) pool.emplace_back(work);
   work();
   for (auto& t : pool) t.join();
 }
@@ -35,11 +40,6 @@ template <class Fn>
 void for_each_index(std::size_t n, Fn fn) {
   for_each_index(
       n, [] { return 0; }, [&](int, std::size_t i) { fn(i); });
-}
-
-namespace detail {
-void for_each_on_pool(std::size_t n, std::size_t serial_up_to,
-                      const std::function<void(std::size_t)>& fn);
 }
 
 // fn(i) for every i in [0, n), for items that each take tens of microseconds or more, a frame's
