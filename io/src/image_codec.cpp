@@ -87,22 +87,30 @@ Image8 decode_image(const std::string& bytes, const std::string& source) {
   if (std::uint64_t(w) * h > kMaxPixels)
     throw InputError({source, "", ""}, "image of " + std::to_string(w) + " x " + std::to_string(h) +
                                            " pixels: more than lampnav reads");
-  // imdecode reads the bytes in place (it does not write to its input).
+  // imdecode reads the bytes in place (it does not write to its input). A grey 8-bit image, the
+  // usual case, is decoded straight into the result's pixels (the header said its size): a frame
+  // is not allocated and copied twice. A JPEG is read as grey by libjpeg itself, which for a colour
+  // JPEG takes its luma and skips the colour planes. Anything else comes back in a buffer of
+  // OpenCV's and is converted.
   const cv::Mat buf(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data()));
-  cv::Mat m;
+  Image8 out(static_cast<int>(w), static_cast<int>(h));
+  cv::Mat m(out.height, out.width, CV_8UC1, out.pixels.data());
   try {
-    m = cv::imdecode(buf, cv::IMREAD_UNCHANGED);
+    cv::imdecode(buf, jpeg ? cv::IMREAD_GRAYSCALE : cv::IMREAD_UNCHANGED, &m);
   } catch (const cv::Exception& e) {
     throw InputError({source, "", ""}, std::string("image does not decode: ") + e.what());
   }
   if (m.empty())
     throw InputError({source, "", ""}, "image does not decode (not PNG or JPEG, or damaged)");
+  if (m.data == out.pixels.data() && m.type() == CV_8UC1 && m.cols == out.width &&
+      m.rows == out.height)
+    return out;
   if (m.depth() == CV_16U) m.convertTo(m, CV_8U, 1.0 / 257.0);
   if (m.depth() != CV_8U)
     throw InputError({source, "", ""}, "unsupported image depth (8 or 16 bits per channel)");
   if (m.channels() == 3) cv::cvtColor(m, m, cv::COLOR_BGR2GRAY);
   if (m.channels() == 4) cv::cvtColor(m, m, cv::COLOR_BGRA2GRAY);
-  Image8 out(m.cols, m.rows);
+  out = Image8(m.cols, m.rows);
   for (int y = 0; y < m.rows; ++y)
     std::copy_n(m.ptr<std::uint8_t>(y), m.cols, &out.pixels[static_cast<std::size_t>(y) * m.cols]);
   return out;

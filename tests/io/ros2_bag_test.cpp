@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <random>
 
 #include "cdr_writer.hpp"
@@ -452,6 +454,61 @@ TEST(Ros2Bag, CameraMountsFromTheBagsTransforms) {
   ASSERT_TRUE(m2);
   EXPECT_EQ(m2->base, "base_link");
   EXPECT_TRUE(m2->xyz.isApprox(Eigen::Vector3d(0.2, 0.1, 1.5), 1e-12));
+}
+
+// What cameras send besides grey 8-bit frames comes out grey: a colour JPEG as its luma (libjpeg
+// reads only that plane), within 2 grey levels of OpenCV's own colour-to-grey of the same JPEG
+// (colours whose decoding does not clip; where it clips, the luma is the truer of the two); a
+// 16-bit PNG scaled to 8 bits; a PNG with alpha converted. A grey JPEG gives what OpenCV gives.
+TEST(Images, ColourAndDeepImagesComeOutGrey) {
+  cv::Mat colour(48, 64, CV_8UC3);
+  for (int y = 0; y < colour.rows; ++y)
+    for (int x = 0; x < colour.cols; ++x)
+      colour.at<cv::Vec3b>(y, x) =
+          cv::Vec3b(static_cast<std::uint8_t>(x * 4), static_cast<std::uint8_t>(y * 5),
+                    static_cast<std::uint8_t>(250 - 2 * (x + y)));
+  auto bytes = [](const cv::Mat& m, const char* ext) {
+    std::vector<std::uint8_t> b;
+    EXPECT_TRUE(cv::imencode(ext, m, b));
+    return std::string(b.begin(), b.end());
+  };
+  const std::string jpeg = bytes(colour, ".jpg");
+  const Image8 grey = decode_image(jpeg, "colour.jpg");
+  ASSERT_EQ(grey.width, 64);
+  ASSERT_EQ(grey.height, 48);
+  cv::Mat theirs;
+  cv::cvtColor(cv::imdecode(cv::Mat(1, static_cast<int>(jpeg.size()), CV_8UC1,
+                                    const_cast<char*>(jpeg.data())),
+                            cv::IMREAD_COLOR),
+               theirs, cv::COLOR_BGR2GRAY);
+  int worst = 0;
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 64; ++x)
+      worst = std::max(worst, std::abs(int(grey.at(x, y)) - int(theirs.at<std::uint8_t>(y, x))));
+  EXPECT_LE(worst, 2);
+
+  cv::Mat deep(5, 6, CV_16UC1);
+  for (int k = 0; k < 30; ++k)
+    deep.at<std::uint16_t>(k / 6, k % 6) = static_cast<std::uint16_t>(k * 2000);
+  const Image8 scaled = decode_image(bytes(deep, ".png"), "deep.png");
+  ASSERT_EQ(scaled.width, 6);
+  for (int k = 0; k < 30; ++k) EXPECT_EQ(scaled.pixels[k], std::lround(k * 2000 / 257.0)) << k;
+
+  cv::Mat alpha(3, 4, CV_8UC4, cv::Scalar(10, 200, 30, 128));
+  const Image8 flat = decode_image(bytes(alpha, ".png"), "alpha.png");
+  ASSERT_EQ(flat.width, 4);
+  cv::Mat expected;
+  cv::cvtColor(alpha, expected, cv::COLOR_BGRA2GRAY);
+  EXPECT_EQ(flat.at(2, 1), expected.at<std::uint8_t>(1, 2));
+
+  const Image8 g = gradient(33, 17);
+  const std::string grey_jpeg = encode_jpeg(g, 75);
+  const cv::Mat same = cv::imdecode(
+      cv::Mat(1, static_cast<int>(grey_jpeg.size()), CV_8UC1, const_cast<char*>(grey_jpeg.data())),
+      cv::IMREAD_UNCHANGED);
+  const Image8 ours = decode_image(grey_jpeg, "grey.jpg");
+  ASSERT_EQ(same.type(), CV_8UC1);
+  EXPECT_EQ(ours.pixels, std::vector<std::uint8_t>(same.datastart, same.dataend));
 }
 
 // Images are PNG or JPEG, told by their bytes (OpenCV's other decoders, JPEG 2000 among them, are
