@@ -14,6 +14,8 @@
 #include <random>
 
 #include "lampnav/graph/geojson.hpp"
+#include "lampnav/io/image_encoding.hpp"
+#include "lampnav/io/mission_log.hpp"
 #include "lampnav/sim/renderers.hpp"
 #include "lampnav/vision/lamp_tracker.hpp"
 #include "lampnav/vision/omni_detector.hpp"
@@ -172,13 +174,17 @@ void BM_VispSearchDotsInArea(benchmark::State& state) {
 BENCHMARK(BM_VispSearchDotsInArea)->Arg(352)->Arg(640)->Unit(benchmark::kMicrosecond);
 
 // Ten museum views, floor bumps on, people and spurious lights as the simulator draws them.
+// Omni frames of the museum hall at random poses, or of the office (`office`), whose corridors put
+// rows of lamps near the horizon, where they bloom into long arcs, at poses along its corridors.
 struct OmniFrames {
   RobotDescription robot;
   std::vector<Image8> images;
-  OmniFrames() {
+  explicit OmniFrames(bool office) {
     const std::string src = LAMPNAV_SOURCE_DIR;
     robot = read_robot_description(src + "/maps/robots/pioneer.json");
-    const auto map = graph::read_map(src + "/maps/domus_museum.geojson").map;
+    const auto map = graph::read_map(src + (office ? "/maps/office_floor.geojson"
+                                                   : "/maps/domus_museum.geojson"))
+                         .map;
     std::vector<const graph::Lamp*> lamps;
     for (const auto& n : map.nodes())
       for (const auto& l : n.lamps) lamps.push_back(&l);
@@ -186,27 +192,38 @@ struct OmniFrames {
     std::mt19937_64 rng(4);
     std::uniform_real_distribution<double> u(0, 1);
     std::normal_distribution<double> bump(0, 0.5 * M_PI / 180);
-    for (int k = 0; k < 10; ++k)
-      images.push_back(renderer.render(Pose2(-2 + 24 * u(rng), -9 + 11 * u(rng), 6.28 * u(rng)),
-                                       {bump(rng), bump(rng)}, lamps, rng));
+    for (int k = 0; k < 10; ++k) {
+      Pose2 pose(-2 + 24 * u(rng), -9 + 11 * u(rng), 6.28 * u(rng));
+      if (office) {  // a point on the line between the two ends of an edge, facing along it
+        const graph::Edge& e = map.edge_at_index(k % map.edges().size());
+        const Eigen::Vector2d a = map.node(e.start).point, b = map.node(e.end).point;
+        const Eigen::Vector2d p = a + u(rng) * (b - a);
+        pose = Pose2(p.x(), p.y(), std::atan2(b.y() - a.y(), b.x() - a.x()));
+      }
+      images.push_back(renderer.render(pose, {bump(rng), bump(rng)}, lamps, rng));
+    }
   }
 };
 
-const OmniFrames& omni_frames() {
-  static const OmniFrames f;
-  return f;
+const OmniFrames& omni_frames(bool office = false) {
+  static const OmniFrames museum(false), offices(true);
+  return office ? offices : museum;
 }
 
+// Argument 1: the office's frames (blooms to split on most of them), 0: the museum's.
 void BM_OmniDetector(benchmark::State& state) {
-  const OmniFrames& f = omni_frames();
+  const OmniFrames& f = omni_frames(state.range(0) == 1);
   vision::OmniLampDetector det(*f.robot.find_camera("omni_camera"));
   std::size_t k = 0;
+  double blooms = 0;
   for (auto _ : state) {
     const auto d = det.detect(vision::ImageView::of(f.images[k++ % f.images.size()]));
+    blooms += d.split_blooms;
     benchmark::DoNotOptimize(d.blobs.data());
   }
+  state.counters["split_blooms"] = blooms / state.iterations();
 }
-BENCHMARK(BM_OmniDetector)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_OmniDetector)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 void BM_PaperOmniPipelineOpenCv(benchmark::State& state) {
   const OmniFrames& f = omni_frames();
@@ -217,6 +234,23 @@ void BM_PaperOmniPipelineOpenCv(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_PaperOmniPipelineOpenCv)->Unit(benchmark::kMicrosecond);
+
+// Decoding a 1024 x 1024 omni frame as the node does when it arrives (io::decode_image): PNG as the
+// simulator writes, or JPEG at the argument's quality as camera drivers compress.
+void BM_DecodeOmniFrame(benchmark::State& state) {
+  const OmniFrames& f = omni_frames();
+  io::ImageEncoding e;
+  e.format = state.range(0) > 0 ? io::ImageEncoding::Format::jpeg : io::ImageEncoding::Format::png;
+  if (state.range(0) > 0) e.jpeg_quality = static_cast<int>(state.range(0));
+  std::vector<std::string> bytes;
+  for (const Image8& image : f.images) bytes.push_back(io::encode_image(image, e));
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const Image8 image = io::decode_image(bytes[k++ % bytes.size()], "omni frame");
+    benchmark::DoNotOptimize(image.pixels.data());
+  }
+}
+BENCHMARK(BM_DecodeOmniFrame)->Arg(0)->Arg(90)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

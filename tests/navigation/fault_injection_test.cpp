@@ -114,8 +114,9 @@ TEST(FaultInjection, OdometryStopsFor10Seconds) {
   EXPECT_EQ(r.metrics.input_faults[0].gaps, 1u);
   EXPECT_NEAR(r.metrics.input_faults[0].longest_gap_s, 10.0, 0.1);
   // The localizer lets go of the pose and says why, as a cause a program can act on: the ceiling
-  // frames of the gap contradict a robot that seems to stand still, or the gap itself. Then a
-  // global fix, and a measurement that confirms it.
+  // frames of the gap contradict a robot that seems to stand still, or the gap itself. Then,
+  // perhaps after naming the places it could be (the omni view along C1 fits more than one while
+  // the wheels say nothing) and the gap, a global fix, and a measurement that confirms it.
   std::vector<fusion::ModeCause> causes;
   for (const auto& e : r.events) {
     std::cout << to_seconds(e.stamp) << " s: " << fusion::to_string(e.cause) << ", " << e.reason
@@ -128,7 +129,12 @@ TEST(FaultInjection, OdometryStopsFor10Seconds) {
               causes.front() == fusion::ModeCause::odometry_gap)
       << fusion::to_string(causes.front());
   EXPECT_GE(to_seconds(r.events.front().stamp), 29.5);
-  EXPECT_EQ(causes[1], fusion::ModeCause::global_fix);
+  std::size_t fix = 1;
+  while (fix < causes.size() && (causes[fix] == fusion::ModeCause::hypotheses_undecided ||
+                                 causes[fix] == fusion::ModeCause::odometry_gap))
+    ++fix;
+  ASSERT_LT(fix, causes.size());
+  EXPECT_EQ(causes[fix], fusion::ModeCause::global_fix);
 
   EXPECT_EQ(r.metrics.wrong_fixes, 0);
   EXPECT_EQ(r.outcome.wheel_readings, log.wheels.size());

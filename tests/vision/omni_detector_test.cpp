@@ -123,6 +123,39 @@ TEST(OmniLampDetector, SplitsBloomsWithTheSecondThreshold) {
   EXPECT_GE(near, 2);
 }
 
+// A bloom's bounding box can hold other blobs: near the horizon a row of lamps blooms into an arc
+// half the image wide. Only the bloom's own pixels are split at the second threshold; a lamp
+// inside its box but apart from it is found once, as itself. (The box used to be split whole, and
+// such a lamp came out twice: 11 blobs too many a frame on the office's corridors.)
+TEST(OmniLampDetector, ABloomSplitsOnlyItsOwnPixels) {
+  Museum m;
+  OmniLampDetector det(m.cam);
+  Image8 img(m.cam.width, m.cam.height, 0);
+  // A bloom: an L of grey 200 with two saturated cores, around (not touching) a small saturated
+  // lamp of 5 x 5 pixels.
+  for (int v = 300; v < 340; ++v)
+    for (int u = 300; u < 500; ++u) img.at(u, v) = 200;
+  for (int v = 300; v < 500; ++v)
+    for (int u = 300; u < 340; ++u) img.at(u, v) = 200;
+  for (int v = 310; v < 330; ++v)
+    for (int u = 450; u < 470; ++u) img.at(u, v) = 255;
+  for (int v = 450; v < 470; ++v)
+    for (int u = 310; u < 330; ++u) img.at(u, v) = 255;
+  for (int v = 420; v < 425; ++v)
+    for (int u = 420; u < 425; ++u) img.at(u, v) = 255;
+  const OmniDetection d = det.detect(ImageView::of(img));
+  EXPECT_EQ(d.raw_blobs, 2);
+  EXPECT_EQ(d.split_blooms, 1);
+  ASSERT_EQ(d.blobs.size(), 3u);
+  int lamp = 0, cores = 0;
+  for (const OmniBlob& b : d.blobs) {
+    if (!b.from_bloom && b.pixels == 25) ++lamp;
+    if (b.from_bloom && b.pixels == 400) ++cores;
+  }
+  EXPECT_EQ(lamp, 1);
+  EXPECT_EQ(cores, 2);
+}
+
 TEST(OmniLampDetector, BlackSpecksAndWrongImages) {
   Museum m;
   OmniLampDetector det(m.cam);

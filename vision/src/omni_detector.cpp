@@ -1,5 +1,6 @@
 #include "lampnav/vision/omni_detector.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "blobs.hpp"
@@ -88,13 +89,17 @@ struct OmniLampDetector::Impl {
         add(first, b, 0, 0, false, &out);
         continue;
       }
-      // A bloom: label its bounding box again at the higher threshold (paper 1, Fig. 9).
+      // A bloom: label its pixels again at the higher threshold (paper 1, Fig. 9). They are copied
+      // run by run into its bounding box, dark elsewhere: the box of a bloom near the horizon can
+      // be half the image, and it may hold other blobs, which are not this bloom's to split.
       const int w = b.u1 - b.u0 + 1, h = b.v1 - b.v0 + 1;
-      crop.resize(static_cast<std::size_t>(w) * h);
-      for (int v = 0; v < h; ++v)
-        for (int u = 0; u < w; ++u)
-          crop[static_cast<std::size_t>(v) * w + u] =
-              first.bright(b.u0 + u, b.v0 + v) ? g.data[(b.v0 + v) * g.row_stride() + b.u0 + u] : 0;
+      crop.assign(static_cast<std::size_t>(w) * h, 0);
+      for (int k = 0; k < b.run_count; ++k) {
+        const detail::Run& r = first.run(b.first_run + k);
+        std::copy_n(g.data + static_cast<std::size_t>(r.row) * g.row_stride() + r.u0,
+                    r.u1 - r.u0 + 1,
+                    crop.data() + static_cast<std::size_t>(r.row - b.v0) * w + (r.u0 - b.u0));
+      }
       second.label(ImageView{crop.data(), w, h, 1, 1, static_cast<std::size_t>(w)},
                    static_cast<std::uint8_t>(o.bloom_threshold));
       if (second.blobs().empty()) {  // no saturated core: keep the blob as it was
