@@ -345,8 +345,18 @@ int main(int argc, char** argv) {
     add_counter(std::string("replay of a 6-minute mission, ") + n + "-node building",
                 std::string("BM_ReplayBuildingMission/") + n, "realtime_factor", 50, "x real time");
   grows("replay", "BM_ReplayBuildingMission");
-  add("map build from a recorded 10-minute drive (100-node building)", us("BM_MapBuildFromLog"), "",
-      std::nullopt, 20e6, std::nullopt);
+  add("map build from a recorded 10-minute drive (100-node building)", us("BM_MapBuildFromLog/5"),
+      "", std::nullopt, 20e6, std::nullopt);
+  for (const char* seed : {"5", "11", "23"}) {
+    const std::string bench = std::string("BM_MapBuildFromLog/") + seed;
+    const std::string drive = std::string("map of a 10-minute drive, building ") + seed;
+    add_value(drive + ", lamp position RMS", counter(bench, "rms_cm", 1), "", std::nullopt, 2.0,
+              std::nullopt, "cm");
+    add_value(drive + ", lamp position max", counter(bench, "max_cm", 1), "", std::nullopt, 5.0,
+              std::nullopt, "cm");
+    add_value(drive + ", lamp height max", counter(bench, "height_max_cm", 1), "", std::nullopt,
+              3.0, std::nullopt, "cm");
+  }
   for (const auto& [arg, format] : {std::pair{"0", "PNG"}, {"90", "JPEG 90"}}) {
     const std::string bench = std::string("BM_NodeImageToPose/") + arg;
     for (const char* camera : {"ceiling", "omni"})
