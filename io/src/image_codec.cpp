@@ -70,6 +70,53 @@ std::pair<std::uint32_t, std::uint32_t> declared_size(const std::string& b, bool
   return {0, 0};
 }
 
+// OpenCV's allocator for one decoding: the first grey 8-bit buffer of exactly `pixels`' size is
+// `pixels` itself (OpenCV does not free it); anything else is OpenCV's own memory, freed by it.
+class IntoPixels : public cv::MatAllocator {
+ public:
+  explicit IntoPixels(std::vector<std::uint8_t>& pixels) : pixels_(pixels) {}
+
+  cv::UMatData* allocate(int dims, const int* sizes, int type, void* data, size_t* step,
+                         cv::AccessFlag, cv::UMatUsageFlags) const override {
+    std::size_t total = CV_ELEM_SIZE(type);
+    for (int i = dims - 1; i >= 0; --i) {
+      if (step) {
+        if (data && step[i] != kAutoStep)
+          total = std::max(total, step[i]);
+        else
+          step[i] = total;
+      }
+      total *= static_cast<std::size_t>(sizes[i]);
+    }
+    auto* u = new cv::UMatData(this);
+    if (data) {
+      u->data = u->origdata = static_cast<uchar*>(data);
+      u->flags |= cv::UMatData::USER_ALLOCATED;
+    } else if (!given_ && type == CV_8UC1 && total == pixels_.size()) {
+      given_ = true;
+      u->data = u->origdata = pixels_.data();
+      u->flags |= cv::UMatData::USER_ALLOCATED;
+    } else {
+      u->data = u->origdata = static_cast<uchar*>(cv::fastMalloc(total));
+    }
+    u->size = total;
+    return u;
+  }
+  bool allocate(cv::UMatData* u, cv::AccessFlag, cv::UMatUsageFlags) const override {
+    return u != nullptr;
+  }
+  void deallocate(cv::UMatData* u) const override {
+    if (!u) return;
+    if (!(u->flags & cv::UMatData::USER_ALLOCATED)) cv::fastFree(u->origdata);
+    delete u;
+  }
+
+ private:
+  static constexpr std::size_t kAutoStep = 0x7fffffff;  // CV_AUTOSTEP of OpenCV's C API
+  std::vector<std::uint8_t>& pixels_;
+  mutable bool given_ = false;
+};
+
 }  // namespace
 
 Image8 decode_image(const std::string& bytes, const std::string& source) {
@@ -88,13 +135,17 @@ Image8 decode_image(const std::string& bytes, const std::string& source) {
     throw InputError({source, "", ""}, "image of " + std::to_string(w) + " x " + std::to_string(h) +
                                            " pixels: more than lampnav reads");
   // imdecode reads the bytes in place (it does not write to its input). A grey 8-bit image, the
-  // usual case, is decoded straight into the result's pixels (the header said its size): a frame
-  // is not allocated and copied twice. A JPEG is read as grey by libjpeg itself, which for a colour
-  // JPEG takes its luma and skips the colour planes. Anything else comes back in a buffer of
-  // OpenCV's and is converted.
+  // usual case, is decoded straight into the result's pixels: OpenCV asks IntoPixels for its
+  // buffer, and gets the result's when the image is the size the header said. A frame is then not
+  // allocated and copied twice (on this machine that was most of the time a frame took). The Mat
+  // starts empty, so a header OpenCV refuses leaves it empty and is reported as such. A JPEG is
+  // read as grey by libjpeg itself, which for a colour JPEG takes its luma and skips the colour
+  // planes. Anything else comes back in a buffer of OpenCV's and is converted.
   const cv::Mat buf(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data()));
   Image8 out(static_cast<int>(w), static_cast<int>(h));
-  cv::Mat m(out.height, out.width, CV_8UC1, out.pixels.data());
+  IntoPixels into(out.pixels);
+  cv::Mat m;
+  m.allocator = &into;
   try {
     cv::imdecode(buf, jpeg ? cv::IMREAD_GRAYSCALE : cv::IMREAD_UNCHANGED, &m);
   } catch (const cv::Exception& e) {
@@ -110,10 +161,10 @@ Image8 decode_image(const std::string& bytes, const std::string& source) {
     throw InputError({source, "", ""}, "unsupported image depth (8 or 16 bits per channel)");
   if (m.channels() == 3) cv::cvtColor(m, m, cv::COLOR_BGR2GRAY);
   if (m.channels() == 4) cv::cvtColor(m, m, cv::COLOR_BGRA2GRAY);
-  out = Image8(m.cols, m.rows);
+  Image8 grey(m.cols, m.rows);
   for (int y = 0; y < m.rows; ++y)
-    std::copy_n(m.ptr<std::uint8_t>(y), m.cols, &out.pixels[static_cast<std::size_t>(y) * m.cols]);
-  return out;
+    std::copy_n(m.ptr<std::uint8_t>(y), m.cols, &grey.pixels[static_cast<std::size_t>(y) * m.cols]);
+  return grey;
 }
 
 std::string ImageEncoding::to_string() const {
