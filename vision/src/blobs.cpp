@@ -3,7 +3,35 @@
 #include <algorithm>
 #include <cstring>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 namespace lampnav::vision::detail {
+
+namespace {
+
+// The first column from u on whose 16-pixel (SSE2) or 8-pixel block holds a pixel >= t, or the
+// first of the last short block: the ceiling is mostly dark, so most of a row is passed over here.
+int skip_dark(const std::uint8_t* row, int u, int w, std::uint8_t t) {
+#if defined(__SSE2__)
+  const __m128i threshold = _mm_set1_epi8(static_cast<char>(t));
+  for (; u + 16 <= w; u += 16) {
+    const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + u));
+    // max(x, t) == x exactly where x >= t (unsigned).
+    if (_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_max_epu8(x, threshold), x)) != 0) break;
+  }
+#else
+  for (; u + 8 <= w; u += 8) {
+    bool any = false;
+    for (int k = 0; k < 8; ++k) any |= row[u + k] >= t;
+    if (any) break;
+  }
+#endif
+  return u;
+}
+
+}  // namespace
 
 int BlobLabeller::find_root(int i) {
   while (runs_[i].parent != i) {
@@ -28,29 +56,17 @@ void BlobLabeller::label(const ImageView& g, std::uint8_t t, const PixelBox& req
   const int w = box_.u1 - box_.u0 + 1, h = box_.v1 - box_.v0 + 1;
   const int du = box_.u0, dv = box_.v0;  // box -> image coordinates
   width_ = w;
-  binary_.resize(static_cast<std::size_t>(w) * h);
-  for (int v = 0; v < h; ++v) {  // a plain loop the compiler vectorizes; no thread pool
-    const std::uint8_t* __restrict in =
-        g.data + static_cast<std::size_t>(v + dv) * g.row_stride() + du;
-    std::uint8_t* __restrict out = binary_.data() + static_cast<std::size_t>(v) * w;
-    for (int u = 0; u < w; ++u) out[u] = in[u] >= t ? 1 : 0;
-  }
   int prev_begin = 0, prev_end = 0;
   for (int v = 0; v < h; ++v) {
-    const std::uint8_t* b = binary_.data() + static_cast<std::size_t>(v) * w;
+    const std::uint8_t* in = g.data + static_cast<std::size_t>(v + dv) * g.row_stride() + du;
     const int cur_begin = static_cast<int>(runs_.size());
     int u = 0;
     while (u < w) {
-      while (u + 8 <= w) {  // skip the dark eight pixels at a time
-        std::uint64_t word;
-        std::memcpy(&word, b + u, 8);
-        if (word != 0) break;
-        u += 8;
-      }
-      while (u < w && b[u] == 0) ++u;
+      u = skip_dark(in, u, w, t);
+      while (u < w && in[u] < t) ++u;
       if (u >= w) break;
       const int start = u;
-      while (u < w && b[u] != 0) ++u;
+      while (u < w && in[u] >= t) ++u;
       const int id = static_cast<int>(runs_.size());
       runs_.push_back({v + dv, start + du, u - 1 + du, id});
     }
@@ -66,6 +82,11 @@ void BlobLabeller::label(const ImageView& g, std::uint8_t t, const PixelBox& req
     prev_begin = cur_begin;
     prev_end = cur_end;
   }
+  // The 0/1 map of bright(), from the runs: the image is read once, the map written where bright.
+  binary_.assign(static_cast<std::size_t>(w) * h, 0);
+  for (const Run& r : runs_)
+    std::memset(binary_.data() + static_cast<std::size_t>(r.row - dv) * w + (r.u0 - du), 1,
+                static_cast<std::size_t>(r.u1 - r.u0 + 1));
   // Blobs, and their runs grouped together (counting sort by blob).
   blobs_.clear();
   blob_of_root_.assign(runs_.size(), -1);

@@ -1,0 +1,98 @@
+// The blob labeller shared by both lamp detectors (vision/src/blobs.hpp, white-box), against
+// OpenCV's connected components (8-connected) on random images of every density, whole and within
+// boxes that cut blobs and reach past the image: the same blobs with the same pixel counts and
+// bounding boxes, and bright() the threshold's mask inside the box and dark outside.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <opencv2/imgproc.hpp>
+#include <random>
+#include <tuple>
+
+#include "blobs.hpp"
+
+namespace lampnav::vision::detail {
+namespace {
+
+using Box = std::tuple<int, int, int, int, int>;  // pixels, u0, v0, u1, v1
+
+std::vector<Box> labelled(const BlobLabeller& lab) {
+  std::vector<Box> out;
+  for (const Blob& b : lab.blobs()) {
+    int pixels = 0;
+    for (int k = 0; k < b.run_count; ++k) {
+      const Run& r = lab.run(b.first_run + k);
+      pixels += r.u1 - r.u0 + 1;
+    }
+    EXPECT_EQ(pixels, b.pixels);
+    out.emplace_back(b.pixels, b.u0, b.v0, b.u1, b.v1);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<Box> opencv(const cv::Mat& grey, std::uint8_t t, const PixelBox& box) {
+  cv::Mat mask = cv::Mat::zeros(grey.size(), CV_8UC1);
+  const cv::Rect roi(box.u0, box.v0, box.u1 - box.u0 + 1, box.v1 - box.v0 + 1);
+  cv::Mat(grey(roi) >= t).copyTo(mask(roi));
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(mask, labels, stats, centroids, 8);
+  std::vector<Box> out;
+  for (int i = 1; i < n; ++i) {
+    const int u0 = stats.at<int>(i, cv::CC_STAT_LEFT), v0 = stats.at<int>(i, cv::CC_STAT_TOP);
+    out.emplace_back(stats.at<int>(i, cv::CC_STAT_AREA), u0, v0,
+                     u0 + stats.at<int>(i, cv::CC_STAT_WIDTH) - 1,
+                     v0 + stats.at<int>(i, cv::CC_STAT_HEIGHT) - 1);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(BlobLabeller, SameBlobsAsOpenCvsConnectedComponents) {
+  std::mt19937 rng(7);
+  BlobLabeller lab;  // one labeller for every case: its scratch is reused
+  int cases = 0;
+  for (const double bright_share : {0.0, 0.001, 0.02, 0.2, 0.5, 0.9, 1.0}) {
+    for (const int width : {1, 15, 16, 17, 33, 100}) {
+      const int height = 1 + static_cast<int>(rng() % 40);
+      cv::Mat grey(height, width, CV_8UC1);
+      std::uniform_real_distribution<double> u(0, 1);
+      for (int v = 0; v < height; ++v)
+        for (int x = 0; x < width; ++x)
+          grey.at<std::uint8_t>(v, x) = u(rng) < bright_share
+                                            ? static_cast<std::uint8_t>(128 + rng() % 128)
+                                            : static_cast<std::uint8_t>(rng() % 128);
+      const ImageView view{grey.data, width, height, 1, 1, static_cast<std::size_t>(grey.step)};
+      const int du = static_cast<int>(rng() % 5), dv = static_cast<int>(rng() % 5);
+      for (const PixelBox& box :
+           {PixelBox{0, 0, width - 1, height - 1}, PixelBox{-3, -2, width / 2, height + 4},
+            PixelBox{du, dv, width - 1 + 7, height / 2 + dv}}) {
+        for (const std::uint8_t t : {std::uint8_t{128}, std::uint8_t{200}, std::uint8_t{255}}) {
+          lab.label(view, t, box);
+          const PixelBox in{std::max(box.u0, 0), std::max(box.v0, 0), std::min(box.u1, width - 1),
+                            std::min(box.v1, height - 1)};
+          if (in.u0 > in.u1 || in.v0 > in.v1) {
+            EXPECT_TRUE(lab.blobs().empty());
+            continue;
+          }
+          ++cases;
+          ASSERT_EQ(labelled(lab), opencv(grey, t, in))
+              << width << " x " << height << ", bright share " << bright_share << ", threshold "
+              << int(t) << ", box " << box.u0 << " " << box.v0 << " " << box.u1 << " " << box.v1;
+          for (int v = -1; v <= height; ++v)
+            for (int x = -1; x <= width; ++x) {
+              const bool inside = in.contains(x, v);
+              const bool expected = inside && grey.at<std::uint8_t>(v, x) >= t;
+              ASSERT_EQ(lab.bright(x, v) != 0, expected) << x << ", " << v;
+            }
+        }
+      }
+    }
+  }
+  EXPECT_GT(cases, 300);
+}
+
+}  // namespace
+}  // namespace lampnav::vision::detail
