@@ -70,11 +70,12 @@ std::pair<std::uint32_t, std::uint32_t> declared_size(const std::string& b, bool
   return {0, 0};
 }
 
-// OpenCV's allocator for one decoding: the first grey 8-bit buffer of exactly `pixels`' size is
-// `pixels` itself (OpenCV does not free it); anything else is OpenCV's own memory, freed by it.
+// OpenCV's allocator for one decoding: the first grey 8-bit buffer of `size` bytes is `pixels`,
+// sized then (so a header OpenCV refuses costs nothing) and not freed by OpenCV; anything else is
+// OpenCV's own memory, freed by it.
 class IntoPixels : public cv::MatAllocator {
  public:
-  explicit IntoPixels(std::vector<std::uint8_t>& pixels) : pixels_(pixels) {}
+  IntoPixels(std::vector<std::uint8_t>& pixels, std::size_t size) : pixels_(pixels), size_(size) {}
 
   cv::UMatData* allocate(int dims, const int* sizes, int type, void* data, size_t* step,
                          cv::AccessFlag, cv::UMatUsageFlags) const override {
@@ -92,8 +93,9 @@ class IntoPixels : public cv::MatAllocator {
     if (data) {
       u->data = u->origdata = static_cast<uchar*>(data);
       u->flags |= cv::UMatData::USER_ALLOCATED;
-    } else if (!given_ && type == CV_8UC1 && total == pixels_.size()) {
+    } else if (!given_ && type == CV_8UC1 && total == size_) {
       given_ = true;
+      pixels_.resize(size_);
       u->data = u->origdata = pixels_.data();
       u->flags |= cv::UMatData::USER_ALLOCATED;
     } else {
@@ -114,6 +116,7 @@ class IntoPixels : public cv::MatAllocator {
  private:
   static constexpr std::size_t kAutoStep = 0x7fffffff;  // CV_AUTOSTEP of OpenCV's C API
   std::vector<std::uint8_t>& pixels_;
+  std::size_t size_;
   mutable bool given_ = false;
 };
 
@@ -142,8 +145,10 @@ Image8 decode_image(const std::string& bytes, const std::string& source) {
   // read as grey by libjpeg itself, which for a colour JPEG takes its luma and skips the colour
   // planes. Anything else comes back in a buffer of OpenCV's and is converted.
   const cv::Mat buf(1, static_cast<int>(bytes.size()), CV_8UC1, const_cast<char*>(bytes.data()));
-  Image8 out(static_cast<int>(w), static_cast<int>(h));
-  IntoPixels into(out.pixels);
+  Image8 out;
+  out.width = static_cast<int>(w);
+  out.height = static_cast<int>(h);
+  IntoPixels into(out.pixels, std::size_t{w} * h);
   cv::Mat m;
   m.allocator = &into;
   try {
@@ -153,8 +158,8 @@ Image8 decode_image(const std::string& bytes, const std::string& source) {
   }
   if (m.empty())
     throw InputError({source, "", ""}, "image does not decode (not PNG or JPEG, or damaged)");
-  if (m.data == out.pixels.data() && m.type() == CV_8UC1 && m.cols == out.width &&
-      m.rows == out.height)
+  if (!out.pixels.empty() && m.data == out.pixels.data() && m.type() == CV_8UC1 &&
+      m.cols == out.width && m.rows == out.height)
     return out;
   if (m.depth() == CV_16U) m.convertTo(m, CV_8U, 1.0 / 257.0);
   if (m.depth() != CV_8U)
