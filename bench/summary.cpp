@@ -301,8 +301,12 @@ int main(int argc, char** argv) {
     add("ceiling detection + tracking, " + size, ours, "vpDot2::searchDotsInArea",
         us("BM_VispSearchDotsInArea/" + p), std::nullopt, std::nullopt);
   }
-  add("omni detection, 1024x1024", us("BM_OmniDetector"), "paper's pipeline on OpenCV",
+  add("omni detection, 1024x1024", us("BM_OmniDetector/0"), "paper's pipeline on OpenCV",
       us("BM_PaperOmniPipelineOpenCv"), 2000.0, std::nullopt);
+  add("omni detection, 1024x1024, office corridors (blooms)", us("BM_OmniDetector/1"), "",
+      std::nullopt, 2000.0, std::nullopt);
+  add("omni frame decoding, 1024x1024, JPEG 90", us("BM_DecodeOmniFrame/90"),
+      "PNG of the same frames", us("BM_DecodeOmniFrame/0"), std::nullopt, std::nullopt);
   add("EKF predict", us("BM_EkfPredict"), "", std::nullopt, 0.1, std::nullopt);
   const auto pu = us("BM_EkfPredictAndGatedUpdate"), pr = us("BM_EkfPredict");
   add("EKF gated update (predict + update minus predict)",
