@@ -173,9 +173,9 @@ void BM_VispSearchDotsInArea(benchmark::State& state) {
 }
 BENCHMARK(BM_VispSearchDotsInArea)->Arg(352)->Arg(640)->Unit(benchmark::kMicrosecond);
 
-// Ten museum views, floor bumps on, people and spurious lights as the simulator draws them.
-// Omni frames of the museum hall at random poses, or of the office (`office`), whose corridors put
-// rows of lamps near the horizon, where they bloom into long arcs, at poses along its corridors.
+// Ten omni views, floor bumps on, people and spurious lights as the simulator draws them: of the
+// museum hall at random poses, or of the office (`office`) at poses along its corridors, whose
+// rows of lamps near the horizon bloom into long arcs.
 struct OmniFrames {
   RobotDescription robot;
   std::vector<Image8> images;
@@ -193,21 +193,28 @@ struct OmniFrames {
     std::uniform_real_distribution<double> u(0, 1);
     std::normal_distribution<double> bump(0, 0.5 * M_PI / 180);
     for (int k = 0; k < 10; ++k) {
-      Pose2 pose(-2 + 24 * u(rng), -9 + 11 * u(rng), 6.28 * u(rng));
+      Pose2 pose;
       if (office) {  // a point on the line between the two ends of an edge, facing along it
         const graph::Edge& e = map.edge_at_index(k % map.edges().size());
         const Eigen::Vector2d a = map.node(e.start).point, b = map.node(e.end).point;
         const Eigen::Vector2d p = a + u(rng) * (b - a);
         pose = Pose2(p.x(), p.y(), std::atan2(b.y() - a.y(), b.x() - a.x()));
+      } else {
+        pose = Pose2(-2 + 24 * u(rng), -9 + 11 * u(rng), 6.28 * u(rng));
       }
       images.push_back(renderer.render(pose, {bump(rng), bump(rng)}, lamps, rng));
     }
   }
 };
 
+// Each set is rendered the first time it is asked for.
 const OmniFrames& omni_frames(bool office = false) {
-  static const OmniFrames museum(false), offices(true);
-  return office ? offices : museum;
+  if (office) {
+    static const OmniFrames offices(true);
+    return offices;
+  }
+  static const OmniFrames museum(false);
+  return museum;
 }
 
 // Argument 1: the office's frames (blooms to split on most of them), 0: the museum's.
