@@ -289,7 +289,7 @@ void write_replay(const ReplayResult& r, const io::MissionLog& log,
       p.pose = e.pose;
       for (int k = 0; k < 9; ++k) p.covariance[k] = e.covariance(k / 3, k % 3);
       p.node = e.node;
-      p.mode = fusion::to_string(e.mode);
+      p.mode = e.mode;
       w.write(e.stamp, p);
     }
     for (const auto& f : r.lamp_frames) w.write(f.arrival, f.observations);
@@ -305,7 +305,7 @@ void write_replay(const ReplayResult& r, const io::MissionLog& log,
     for (const auto& h : r.hypotheses) {
       io::Hypotheses msg;
       msg.stamp = h.stamp;
-      msg.mode = fusion::to_string(h.mode);
+      msg.mode = h.mode;
       for (const auto& p : h.hypotheses)
         msg.hypotheses.push_back({p.pose, p.weight, p.node ? p.node->name : ""});
       w.write(h.stamp, msg);

@@ -9,20 +9,6 @@
 
 namespace lampnav::fusion {
 
-const char* to_string(LocalizerMode m) {
-  switch (m) {
-    case LocalizerMode::tracking:
-      return "tracking";
-    case LocalizerMode::lost:
-      return "lost";
-    case LocalizerMode::relocalized:
-      return "relocalized";
-    case LocalizerMode::ambiguous:
-      return "ambiguous";
-  }
-  return "?";
-}
-
 void LocalizerOptions::validate() const {
   ekf.validate();
   calibration.validate();

@@ -234,7 +234,7 @@ void MissionLogWriter::write(Stamp available, const PoseEstimate& e) {
                   {"yaw", e.pose.yaw()},
                   {"covariance", cov},
                   {"node", e.node},  // "" in no region: Foxglove parses no type unions
-                  {"mode", e.mode}});
+                  {"mode", to_string(e.mode)}});
 }
 
 void MissionLogWriter::write(Stamp available, const LampObservations& o) {
@@ -258,8 +258,9 @@ void MissionLogWriter::write(Stamp available, const Hypotheses& h) {
                     {"yaw", e.pose.yaw()},
                     {"weight", e.weight},
                     {"node", e.node}});
-  impl_->put(topics::kHypotheses, available, h.stamp,
-             Json{{"timestamp", stamp_json(h.stamp)}, {"mode", h.mode}, {"hypotheses", list}});
+  impl_->put(
+      topics::kHypotheses, available, h.stamp,
+      Json{{"timestamp", stamp_json(h.stamp)}, {"mode", to_string(h.mode)}, {"hypotheses", list}});
 }
 
 void MissionLogWriter::write(Stamp available, const LogMessage& m) {

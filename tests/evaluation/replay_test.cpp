@@ -198,6 +198,19 @@ TEST(WriteReplay, WritesWhatTheSpecListsAndItReadsBack) {
   EXPECT_EQ(count(io::topics::kPose), n);
   EXPECT_EQ(count(io::topics::kEstimate), n);
   EXPECT_EQ(count(io::topics::kScene), 1);
+  // Each estimate carries its mode as the spec's word, the typed mode's own.
+  {
+    const io::McapChannel* c = f.channel(io::topics::kEstimate);
+    ASSERT_NE(c, nullptr);
+    std::size_t k = 0;
+    for (const io::McapMessage& m : f.messages) {
+      if (m.channel_id != c->id || k >= r.estimates.size()) continue;
+      const std::string& text = m.data;
+      const std::string word = std::string("\"mode\":\"") + to_string(r.estimates[k++].mode) + "\"";
+      EXPECT_NE(text.find(word), std::string::npos) << text;
+    }
+    EXPECT_EQ(k, r.estimates.size());
+  }
   EXPECT_GE(count(io::topics::kLog), 2);
   ASSERT_NE(f.attachment("map.geojson"), nullptr);
   EXPECT_EQ(f.attachment("map.geojson")->data, map_text);

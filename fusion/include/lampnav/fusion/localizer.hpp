@@ -25,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "lampnav/core/localizer_mode.hpp"
 #include "lampnav/core/robot_description.hpp"
 #include "lampnav/core/time.hpp"
 #include "lampnav/fusion/ceiling_pipeline.hpp"
@@ -39,13 +40,10 @@
 
 namespace lampnav::fusion {
 
-enum class LocalizerMode { tracking, lost, relocalized, ambiguous };
-const char* to_string(LocalizerMode mode);
-// Whether a pose in this mode is published as certain (tracking, relocalized); lost and
-// ambiguous publish places the robot may be, never one pose.
-inline bool is_certain(LocalizerMode mode) {
-  return mode == LocalizerMode::tracking || mode == LocalizerMode::relocalized;
-}
+// The mode and its word live in core (localizer_mode.hpp): the mission log records them too.
+using lampnav::is_certain;
+using lampnav::LocalizerMode;
+using lampnav::to_string;
 
 struct LocalizerOptions {
   EkfOptions ekf;                          // semi_axis is taken from robot.json

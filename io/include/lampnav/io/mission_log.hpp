@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "lampnav/core/image.hpp"
+#include "lampnav/core/localizer_mode.hpp"
 #include "lampnav/core/pose2.hpp"
 #include "lampnav/core/time.hpp"
 #include "lampnav/io/mcap.hpp"
@@ -79,9 +80,9 @@ struct CommandMessage {
 struct PoseEstimate {
   Stamp stamp;
   Pose2 pose;
-  std::array<double, 9> covariance{};  // row-major, x y yaw
-  std::string node;                    // "" when in no region
-  std::string mode;                    // "tracking", "lost", "relocalized", "ambiguous"
+  std::array<double, 9> covariance{};        // row-major, x y yaw
+  std::string node;                          // "" when in no region
+  LocalizerMode mode = LocalizerMode::lost;  // never certain unless said; its word on the wire
 };
 
 // A line a person reads (/lampnav/log, foxglove.Log): what a replay used, missed or skipped.
@@ -101,7 +102,7 @@ struct HypothesisEntry {
 };
 struct Hypotheses {
   Stamp stamp;
-  std::string mode;
+  LocalizerMode mode = LocalizerMode::lost;
   std::vector<HypothesisEntry> hypotheses;  // best first; empty once one pose is known
 };
 
