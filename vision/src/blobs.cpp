@@ -31,6 +31,19 @@ int skip_dark(const std::uint8_t* row, int u, int w, std::uint8_t t) {
   return u;
 }
 
+// The first column from u on that is below t, or w: a lamp's rows are long bright runs.
+int skip_bright(const std::uint8_t* row, int u, int w, std::uint8_t t) {
+#if defined(__SSE2__)
+  const __m128i threshold = _mm_set1_epi8(static_cast<char>(t));
+  for (; u + 16 <= w; u += 16) {
+    const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + u));
+    if (_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_max_epu8(x, threshold), x)) != 0xFFFF) break;
+  }
+#endif
+  while (u < w && row[u] >= t) ++u;
+  return u;
+}
+
 }  // namespace
 
 int BlobLabeller::find_root(int i) {
@@ -52,6 +65,7 @@ void BlobLabeller::label(const ImageView& g, std::uint8_t t, const PixelBox& req
   blobs_.clear();
   sorted_.clear();
   width_ = 0;
+  binary_filled_ = false;
   if (box_.empty()) return;
   const int w = box_.u1 - box_.u0 + 1, h = box_.v1 - box_.v0 + 1;
   const int du = box_.u0, dv = box_.v0;  // box -> image coordinates
@@ -66,7 +80,7 @@ void BlobLabeller::label(const ImageView& g, std::uint8_t t, const PixelBox& req
       while (u < w && in[u] < t) ++u;
       if (u >= w) break;
       const int start = u;
-      while (u < w && in[u] >= t) ++u;
+      u = skip_bright(in, u, w, t);
       const int id = static_cast<int>(runs_.size());
       runs_.push_back({v + dv, start + du, u - 1 + du, id});
     }
@@ -82,11 +96,7 @@ void BlobLabeller::label(const ImageView& g, std::uint8_t t, const PixelBox& req
     prev_begin = cur_begin;
     prev_end = cur_end;
   }
-  // The 0/1 map of bright(), from the runs: the image is read once, the map written where bright.
-  binary_.assign(static_cast<std::size_t>(w) * h, 0);
-  for (const Run& r : runs_)
-    std::memset(binary_.data() + static_cast<std::size_t>(r.row - dv) * w + (r.u0 - du), 1,
-                static_cast<std::size_t>(r.u1 - r.u0 + 1));
+  binary_filled_ = false;
   // Blobs, and their runs grouped together (counting sort by blob).
   blobs_.clear();
   blob_of_root_.assign(runs_.size(), -1);
@@ -118,6 +128,17 @@ void BlobLabeller::label(const ImageView& g, std::uint8_t t, const PixelBox& req
     Blob& c = blobs_[blob_of_run_[i]];
     sorted_[c.first_run + c.run_count++] = static_cast<int>(i);
   }
+}
+
+void BlobLabeller::fill_binary() const {
+  // The 0/1 map, from the runs: the image is read once, the map written where bright.
+  const int h = box_.v1 - box_.v0 + 1;
+  binary_.assign(static_cast<std::size_t>(width_) * h, 0);
+  for (const Run& r : runs_)
+    std::memset(
+        binary_.data() + static_cast<std::size_t>(r.row - box_.v0) * width_ + (r.u0 - box_.u0), 1,
+        static_cast<std::size_t>(r.u1 - r.u0 + 1));
+  binary_filled_ = true;
 }
 
 int BlobLabeller::perimeter(const Blob& b) const {

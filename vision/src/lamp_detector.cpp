@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -20,8 +21,21 @@ void require(bool ok, const char* what, const char* field, const std::string& me
   if (!ok) throw InputError({"", what, field}, message);
 }
 
+// The first k' >= k with row[k'] != value (n if none), for a row of 0/1 bytes: eight at a time
+// while they all equal `value`.
+int skip_while(const std::uint8_t* row, int k, int n, std::uint8_t value) {
+  const std::uint64_t all = value ? 0x0101010101010101ull : 0;
+  for (std::uint64_t word; k + 8 <= n; k += 8) {
+    std::memcpy(&word, row + k, 8);
+    if (word != all) break;
+  }
+  while (k < n && row[k] == value) ++k;
+  return k;
+}
+
+// A blob's weighted area, centroid and central second moments (each pixel a small square).
 struct Moments {
-  double m0 = 0, mx = 0, my = 0, mxx = 0, mxy = 0, myy = 0;
+  double m0 = 0, cx = 0, cy = 0, mu20 = 0, mu02 = 0, mu11 = 0;
   int pixels = 0;
 };
 
@@ -40,46 +54,52 @@ struct ShapeFit {
 // points (paper 2's completion "with a least square method"), from one initial guess. Points more
 // than three rms from the shape are dropped after the first iterations (fringe, corners).
 ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Vector2d c,
-                   double theta, double min_drop) {
+                   double theta, double min_drop, std::vector<char>& use) {
   ShapeFit fit;
-  std::vector<char> use(pts.size(), 1);
+  use.assign(pts.size(), 1);
   double rms = 0;
   for (int it = 0; it < 20; ++it) {
-    Eigen::Matrix3d JtJ = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d Jtr = Eigen::Vector3d::Zero();
+    // The normal equations J^T J (symmetric: six sums) and J^T r, summed as scalars.
+    double h00 = 0, h01 = 0, h02 = 0, h11 = 0, h12 = 0, h22 = 0, g0 = 0, g1 = 0, g2 = 0;
     const double cs = std::cos(theta), sn = std::sin(theta);
     double sum2 = 0;
     int n = 0, ends = 0, sides = 0;
     const double drop = std::max(min_drop, 3.0 * rms);
+    const bool dropping = it > 2;
     for (std::size_t i = 0; i < pts.size(); ++i) {
-      const Vector2d d = pts[i] - c;
-      const Vector2d q(cs * d.x() + sn * d.y(), -sn * d.x() + cs * d.y());
-      double r;
-      Eigen::Vector3d J;
+      if (!use[i]) continue;  // once dropped, a point stays dropped
+      const double dx = pts[i].x() - c.x(), dy = pts[i].y() - c.y();
+      const double qx = cs * dx + sn * dy, qy = -sn * dx + cs * dy;
+      double r, j0, j1, j2;
       if (rectangle) {
-        const double rx = std::fabs(q.x()) - a, ry = std::fabs(q.y()) - b;
+        const double rx = std::fabs(qx) - a, ry = std::fabs(qy) - b;
         const bool end = std::fabs(rx) < std::fabs(ry);
-        const double s = end ? (q.x() >= 0 ? 1.0 : -1.0) : (q.y() >= 0 ? 1.0 : -1.0);
+        const double s = end ? (qx >= 0 ? 1.0 : -1.0) : (qy >= 0 ? 1.0 : -1.0);
         r = end ? rx : ry;
         // q = R^T (p - c): dq/dc = -R^T, dq/dtheta = (q_y, -q_x).
         if (end) {
-          J << -s * cs, -s * sn, s * q.y();
+          j0 = -s * cs, j1 = -s * sn, j2 = s * qy;
         } else {
-          J << s * sn, -s * cs, -s * q.x();
+          j0 = s * sn, j1 = -s * cs, j2 = -s * qx;
         }
-        if (it > 2 && std::fabs(r) > drop) use[i] = 0;
-        if (!use[i]) continue;
+        if (dropping && std::fabs(r) > drop) {
+          use[i] = 0;
+          continue;
+        }
         (end ? ends : sides) += 1;
       } else {
-        const double dn = d.norm();
+        const double dn = std::sqrt(dx * dx + dy * dy);
         if (dn < 1e-12) continue;
         r = dn - a;
-        J << -d.x() / dn, -d.y() / dn, 0.0;
-        if (it > 2 && std::fabs(r) > drop) use[i] = 0;
-        if (!use[i]) continue;
+        j0 = -dx / dn, j1 = -dy / dn, j2 = 0.0;
+        if (dropping && std::fabs(r) > drop) {
+          use[i] = 0;
+          continue;
+        }
       }
-      JtJ += J * J.transpose();
-      Jtr += J * r;
+      h00 += j0 * j0, h01 += j0 * j1, h02 += j0 * j2;
+      h11 += j1 * j1, h12 += j1 * j2, h22 += j2 * j2;
+      g0 += j0 * r, g1 += j1 * r, g2 += j2 * r;
       sum2 += r * r;
       ++n;
     }
@@ -90,9 +110,12 @@ ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Ve
     // The fit must see an end and a long side of a rectangle, or its position along the lamp
     // (or across it) is not determined.
     if (rectangle && (ends < 4 || sides < 8)) return fit;
+    Eigen::Matrix3d JtJ;
+    JtJ << h00, h01, h02, h01, h11, h12, h02, h12, h22;
+    const Eigen::Vector3d Jtr(g0, g1, g2);
     // A disc has no heading: pin it (unit information, zero gradient) and solve the same 3x3.
     if (!rectangle) JtJ(2, 2) = 1.0;
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(JtJ);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(JtJ, Eigen::EigenvaluesOnly);
     if (eig.eigenvalues()(0) < 1e-9 * std::max(1.0, eig.eigenvalues()(2))) return fit;
     const Eigen::Vector3d step = -JtJ.ldlt().solve(Jtr);
     c += step.head<2>();
@@ -200,6 +223,12 @@ struct LampDetector::Impl {
   int w, h;
   // Per pixel: undistorted normalized coordinates of its centre and the normalized area it covers.
   std::vector<float> lut_x, lut_y, lut_w;
+  // Per row, running sums of the moments' terms over its first k pixels (k = 0..w), so that a
+  // run of pixels costs two lookups, not one per pixel. One cache line an entry.
+  struct alignas(64) RowSums {
+    double w = 0, wx = 0, wy = 0, wxx = 0, wxy = 0, wyy = 0, ww = 0, n = 0;
+  };
+  std::vector<RowSums> row_sums;
   double area_nominal, area_min, area_max;  // of a whole lamp, normalized units^2
   double min_pixels, max_pixels;            // pixel-count bounds that cannot drop a lamp
   // Scratch, reused frame to frame.
@@ -207,6 +236,7 @@ struct LampDetector::Impl {
   detail::BlobLabeller blobs;
   std::vector<std::uint8_t> mask, opened, scratch;
   EdgePoints edges;
+  std::vector<char> fit_use;  // fit_shape: which edge points are still in the fit
 
   Impl(const CameraDescription& camera, const LampShapePrior& p, const LampDetectorOptions& opt)
       : model(camera), prior(p), o(opt), w(camera.width), h(camera.height) {
@@ -230,6 +260,17 @@ struct LampDetector::Impl {
         w_max = std::max(w_max, 1.0 / det);
       }
     }
+    row_sums.resize(static_cast<std::size_t>(w + 1) * h);
+    for (int v = 0; v < h; ++v) {
+      RowSums* r = row_sums.data() + static_cast<std::size_t>(w + 1) * v;
+      for (int u = 0; u < w; ++u) {
+        const std::size_t i = index(u, v);
+        const double wt = lut_w[i], x = lut_x[i], y = lut_y[i];
+        r[u + 1] = {
+            r[u].w + wt,           r[u].wx + wt * x,      r[u].wy + wt * y,  r[u].wxx + wt * x * x,
+            r[u].wxy + wt * x * y, r[u].wyy + wt * y * y, r[u].ww + wt * wt, r[u].n + 1};
+      }
+    }
     const double face =
         prior.rectangle ? prior.length * prior.width : M_PI / 4 * prior.length * prior.length;
     area_nominal = face / (prior.nominal_distance * prior.nominal_distance);
@@ -247,6 +288,11 @@ struct LampDetector::Impl {
   bool measure_blobs(const ImageView& g, const PixelBox& box, LampDetections& out);
   bool measure(const detail::Blob& c, const ImageView& g, LampDetection& out, DetectionStats& st);
   bool complete(const detail::Blob& c, const ImageView& g, int pad, LampDetection& out);
+  // Of the opened mask of blob `c` (padded by `pad`, `mw` wide): its moments, the pixel nearest
+  // the middle of its box, and whether it reaches the image's border.
+  Moments moments(const detail::Blob& c, int pad, int mw) const;
+  std::array<int, 2> seed_near_middle(const detail::Blob& c, int pad, int mw) const;
+  bool touches_image_border(const detail::Blob& c, int pad, int mw) const;
 };
 
 LampDetections LampDetector::Impl::detect(const ImageView& image) {
@@ -355,44 +401,18 @@ bool LampDetector::Impl::measure(const detail::Blob& c, const ImageView& g, Lamp
     opened = mask;
   }
   // Moments in undistorted normalized coordinates, each pixel weighted by the area it covers.
-  Moments m;
-  const int mid_u = (c.u0 + c.u1) / 2, mid_v = (c.v0 + c.v1) / 2;
-  int seed_d = 1 << 30;
-  bool touches_border = false;  // after the opening: a fringe pixel at the border is no cut
-  for (int v = c.v0; v <= c.v1; ++v) {
-    const std::uint8_t* row =
-        opened.data() + static_cast<std::size_t>(v - c.v0 + pad) * mw + pad - c.u0;
-    const std::size_t base = index(0, v);
-    for (int u = c.u0; u <= c.u1; ++u) {
-      if (!row[u]) continue;
-      const std::size_t i = base + u;
-      const double wt = lut_w[i], x = lut_x[i], y = lut_y[i];
-      m.m0 += wt;
-      m.mx += wt * x;
-      m.my += wt * y;
-      // A pixel is a small square, not a point: its own spread adds wt^2 / 12 to each axis.
-      m.mxx += wt * (x * x + wt / 12);
-      m.mxy += wt * x * y;
-      m.myy += wt * (y * y + wt / 12);
-      ++m.pixels;
-      touches_border |= u == 0 || v == 0 || u == w - 1 || v == h - 1;
-      const int d = std::abs(u - mid_u) + std::abs(v - mid_v);
-      if (d < seed_d) {
-        seed_d = d;
-        out.seed = {u, v};
-      }
-    }
-  }
+  const Moments m = moments(c, pad, mw);
   if (m.pixels == 0 || m.m0 <= 0) {
     ++st.too_small;
     return false;
   }
-  const double cx = m.mx / m.m0, cy = m.my / m.m0;
-  const double mu20 = m.mxx / m.m0 - cx * cx, mu02 = m.myy / m.m0 - cy * cy;
-  const double mu11 = m.mxy / m.m0 - cx * cy;
+  const double cx = m.cx, cy = m.cy, mu20 = m.mu20, mu02 = m.mu02, mu11 = m.mu11;
   const double half_sum = 0.5 * (mu20 + mu02);
   const double root = std::sqrt(0.25 * (mu20 - mu02) * (mu20 - mu02) + mu11 * mu11);
   const double l1 = half_sum + root, l2 = std::max(0.0, half_sum - root);
+  out.seed = seed_near_middle(c, pad, mw);
+  // After the opening: a fringe pixel at the border is no cut.
+  const bool touches_border = touches_image_border(c, pad, mw);
   out.centre = Vector2d(cx, cy);
   out.orientation = wrap_axis_angle(0.5 * std::atan2(2 * mu11, mu20 - mu02));
   // Uniform rectangle: variance L^2 / 12 along a side; uniform disc: D^2 / 16 on any axis.
@@ -438,6 +458,73 @@ bool LampDetector::Impl::measure(const detail::Blob& c, const ImageView& g, Lamp
   return true;
 }
 
+Moments LampDetector::Impl::moments(const detail::Blob& c, int pad, int mw) const {
+  // Each run of the opened mask adds the difference of its row's running sums at its ends. A
+  // pixel is a small square, not a point: its own spread adds wt^2 / 12 to each axis.
+  RowSums s;
+  const int n = c.u1 - c.u0 + 1;
+  for (int v = c.v0; v <= c.v1; ++v) {
+    const std::uint8_t* in = opened.data() + static_cast<std::size_t>(v - c.v0 + pad) * mw + pad;
+    const RowSums* r = row_sums.data() + static_cast<std::size_t>(w + 1) * v + c.u0;
+    for (int k = 0; k < n;) {
+      k = skip_while(in, k, n, 0);
+      if (k == n) break;
+      const int end = skip_while(in, k, n, 1);
+      const RowSums &a = r[k], &b = r[end];
+      s.w += b.w - a.w, s.wx += b.wx - a.wx, s.wy += b.wy - a.wy;
+      s.wxx += b.wxx - a.wxx, s.wxy += b.wxy - a.wxy, s.wyy += b.wyy - a.wyy;
+      s.ww += b.ww - a.ww, s.n += b.n - a.n;
+      k = end;
+    }
+  }
+  Moments m;
+  m.pixels = static_cast<int>(std::lround(s.n));
+  m.m0 = s.w;
+  if (m.pixels == 0 || s.w <= 0) return m;
+  m.cx = s.wx / s.w;
+  m.cy = s.wy / s.w;
+  m.mu20 = (s.wxx + s.ww / 12) / s.w - m.cx * m.cx;
+  m.mu02 = (s.wyy + s.ww / 12) / s.w - m.cy * m.cy;
+  m.mu11 = s.wxy / s.w - m.cx * m.cy;
+  return m;
+}
+
+std::array<int, 2> LampDetector::Impl::seed_near_middle(const detail::Blob& c, int pad,
+                                                        int mw) const {
+  // The set pixel with the least |u - mid_u| + |v - mid_v|, the first in row order on ties:
+  // each row searched outwards from mid_u, left before right, while it can still do better.
+  const int mid_u = (c.u0 + c.u1) / 2, mid_v = (c.v0 + c.v1) / 2;
+  int best = 1 << 30;
+  std::array<int, 2> seed{mid_u, mid_v};
+  for (int v = c.v0; v <= c.v1; ++v) {
+    const int dv = std::abs(v - mid_v);
+    if (dv >= best) continue;
+    const std::uint8_t* row =
+        opened.data() + static_cast<std::size_t>(v - c.v0 + pad) * mw + pad - c.u0;
+    for (int t = 0; dv + t < best; ++t) {
+      const int left = mid_u - t, right = mid_u + t;
+      if (left < c.u0 && right > c.u1) break;
+      const int u = left >= c.u0 && row[left] ? left : right <= c.u1 && row[right] ? right : -1;
+      if (u < 0) continue;
+      best = dv + t;
+      seed = {u, v};
+      break;
+    }
+  }
+  return seed;
+}
+
+bool LampDetector::Impl::touches_image_border(const detail::Blob& c, int pad, int mw) const {
+  auto at = [&](int u, int v) {
+    return opened[static_cast<std::size_t>(v - c.v0 + pad) * mw + pad + (u - c.u0)] != 0;
+  };
+  for (int u = c.u0; u <= c.u1; ++u)
+    if ((c.v0 == 0 && at(u, 0)) || (c.v1 == h - 1 && at(u, h - 1))) return true;
+  for (int v = c.v0; v <= c.v1; ++v)
+    if ((c.u0 == 0 && at(0, v)) || (c.u1 == w - 1 && at(w - 1, v))) return true;
+  return false;
+}
+
 // Completion of a lamp cut by the image border (paper 2, Fig. 5): the visible edges, located to a
 // fraction of a pixel where the grey level crosses the threshold, are fitted with the known shape.
 bool LampDetector::Impl::complete(const detail::Blob& c, const ImageView& g, int pad,
@@ -459,11 +546,29 @@ bool LampDetector::Impl::complete(const detail::Blob& c, const ImageView& g, int
   for (int v = c.v0; v <= c.v1; ++v) {
     const std::uint8_t* row = opened.data() + static_cast<std::size_t>(v - c.v0 + pad) * mw + pad;
     const std::uint8_t* grey_row = g.data + static_cast<std::size_t>(v) * stride;
-    for (int u = c.u0; u <= c.u1; ++u) {
-      const int j = u - c.u0;
-      if (!row[j]) continue;
-      const bool left = u > 0 && !row[j - 1], right = u < w - 1 && !row[j + 1];
-      const bool below = v < h - 1 && !row[j + mw], above = v > 0 && !row[j - mw];
+    const bool border_row = v == 0 || v == h - 1;
+    const int n = c.u1 - c.u0 + 1;
+    for (int j = skip_while(row, 0, n, 0); j < n;) {
+      if (!row[j]) {
+        j = skip_while(row, j, n, 0);
+        continue;
+      }
+      // Eight pixels inside a run whose neighbours above and below are all set have no edge
+      // and are not at the image's border (the run goes on on both sides): skipped at once.
+      if (!border_row && j > 0 && row[j - 1] && j + 8 < n && row[j + 8]) {
+        std::uint64_t r8, a8, b8;
+        std::memcpy(&r8, row + j, 8);
+        std::memcpy(&a8, row + j - mw, 8);
+        std::memcpy(&b8, row + j + mw, 8);
+        if ((r8 & a8 & b8) == 0x0101010101010101ull) {
+          j += 8;
+          continue;
+        }
+      }
+      const int u = c.u0 + j++;
+      const int jj = j - 1;
+      const bool left = u > 0 && !row[jj - 1], right = u < w - 1 && !row[jj + 1];
+      const bool below = v < h - 1 && !row[jj + mw], above = v > 0 && !row[jj - mw];
       const bool at_border = u == 0 || v == 0 || u == w - 1 || v == h - 1;
       if (at_border) {
         const std::size_t i = index(u, v);
@@ -506,7 +611,7 @@ bool LampDetector::Impl::complete(const detail::Blob& c, const ImageView& g, int
   ShapeFit best;
   for (const Vector2d& start : {from_end, from_side, from_both, centroid}) {
     const ShapeFit f =
-        fit_shape(edges, prior.rectangle, half_a, half_b, start, out.orientation, 2 * px);
+        fit_shape(edges, prior.rectangle, half_a, half_b, start, out.orientation, 2 * px, fit_use);
     if (f.ok && (!best.ok || f.rms < best.rms)) best = f;
     if (best.ok && best.rms < 0.5 * px) break;  // edges fit to noise level: no other start needed
   }

@@ -5,6 +5,8 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace lampnav::vision {
 
@@ -108,23 +110,44 @@ std::optional<std::vector<PixelBox>> LampTracker::Impl::windows() const {
 bool LampTracker::Impl::ring_unexplained(const ImageView& g,
                                          const std::vector<PixelBox>& boxes) const {
   const int w = g.width, h = g.height;
-  auto bright = [&](int u, int v) {
-    return g.data[static_cast<std::size_t>(v) * g.row_stride() + u] >= threshold;
-  };
-  auto explained = [&](int u, int v) {
+  const std::size_t stride = g.row_stride();
+  // One side of the ring: `n` pixels from `first`, `step` apart, at positions 0..n-1 along it.
+  // The parts inside a box are explained; the rest is read until a bright pixel.
+  std::vector<std::pair<int, int>> covered;  // [a, b] along the side
+  auto side = [&](const std::uint8_t* first, std::size_t step, int n, auto box_span) {
+    covered.clear();
     for (const PixelBox& b : boxes)
-      if (b.contains(u, v)) return true;
-    return false;
+      if (const auto span = box_span(b)) covered.push_back(*span);
+    std::sort(covered.begin(), covered.end());
+    int k = 0;
+    auto dark_until = [&](int end) {
+      for (; k < end; ++k)
+        if (first[static_cast<std::size_t>(k) * step] >= threshold) return false;
+      return true;
+    };
+    for (const auto& [a, b] : covered) {
+      if (!dark_until(std::min(a, n))) return true;
+      k = std::max(k, b + 1);
+    }
+    return !dark_until(n);
   };
-  for (int u = 0; u < w; ++u) {
-    if (bright(u, 0) && !explained(u, 0)) return true;
-    if (bright(u, h - 1) && !explained(u, h - 1)) return true;
-  }
-  for (int v = 1; v < h - 1; ++v) {
-    if (bright(0, v) && !explained(0, v)) return true;
-    if (bright(w - 1, v) && !explained(w - 1, v)) return true;
-  }
-  return false;
+  using Span = std::optional<std::pair<int, int>>;
+  auto along_row = [&](int v) {
+    return [v, w](const PixelBox& b) -> Span {
+      if (b.v0 > v || b.v1 < v || b.u1 < 0 || b.u0 >= w) return std::nullopt;
+      return std::make_pair(std::max(b.u0, 0), std::min(b.u1, w - 1));
+    };
+  };
+  auto along_column = [&](int u) {
+    return [u, h](const PixelBox& b) -> Span {
+      if (b.u0 > u || b.u1 < u || b.v1 < 0 || b.v0 >= h) return std::nullopt;
+      return std::make_pair(std::max(b.v0, 0), std::min(b.v1, h - 1));
+    };
+  };
+  return side(g.data, 1, w, along_row(0)) ||
+         side(g.data + static_cast<std::size_t>(h - 1) * stride, 1, w, along_row(h - 1)) ||
+         side(g.data, stride, h, along_column(0)) ||
+         side(g.data + (w - 1), stride, h, along_column(w - 1));
 }
 
 bool LampTracker::Impl::associate(const LampDetections& found, bool windowed, TrackedFrame& out) {
