@@ -223,12 +223,28 @@ struct LampDetector::Impl {
   int w, h;
   // Per pixel: undistorted normalized coordinates of its centre and the normalized area it covers.
   std::vector<float> lut_x, lut_y, lut_w;
-  // Per row, running sums of the moments' terms over its first k pixels (k = 0..w), so that a
-  // run of pixels costs two lookups, not one per pixel. One cache line an entry.
+  // Per row, running sums of the moments' terms over its first 8k pixels (k = 0..w/8), so that
+  // a run of pixels costs two lookups and at most 14 pixels' terms, not one term per pixel. One
+  // cache line an entry: 0.8 MB at 352x288, 2.5 MB at 640x480.
+  static constexpr int kSumStride = 8;
   struct alignas(64) RowSums {
-    double w = 0, wx = 0, wy = 0, wxx = 0, wxy = 0, wyy = 0, ww = 0, n = 0;
+    double w = 0, wx = 0, wy = 0, wxx = 0, wxy = 0, wyy = 0, ww = 0;
+    void add(double wt, double x, double y) {
+      w += wt, wx += wt * x, wy += wt * y;
+      wxx += wt * x * x, wxy += wt * x * y, wyy += wt * y * y, ww += wt * wt;
+    }
   };
+  int sums_per_row = 0;
   std::vector<RowSums> row_sums;
+  // The sums over pixels [0, u) of row v.
+  RowSums sums_before(int u, int v) const {
+    RowSums s = row_sums[static_cast<std::size_t>(v) * sums_per_row + u / kSumStride];
+    for (int k = u - u % kSumStride; k < u; ++k) {
+      const std::size_t i = index(k, v);
+      s.add(lut_w[i], lut_x[i], lut_y[i]);
+    }
+    return s;
+  }
   double area_nominal, area_min, area_max;  // of a whole lamp, normalized units^2
   double min_pixels, max_pixels;            // pixel-count bounds that cannot drop a lamp
   // Scratch, reused frame to frame.
@@ -260,16 +276,17 @@ struct LampDetector::Impl {
         w_max = std::max(w_max, 1.0 / det);
       }
     }
-    row_sums.resize(static_cast<std::size_t>(w + 1) * h);
+    sums_per_row = w / kSumStride + 1;
+    row_sums.resize(static_cast<std::size_t>(sums_per_row) * h);
     for (int v = 0; v < h; ++v) {
-      RowSums* r = row_sums.data() + static_cast<std::size_t>(w + 1) * v;
+      RowSums* r = row_sums.data() + static_cast<std::size_t>(sums_per_row) * v;
+      RowSums running;
       for (int u = 0; u < w; ++u) {
+        if (u % kSumStride == 0) r[u / kSumStride] = running;
         const std::size_t i = index(u, v);
-        const double wt = lut_w[i], x = lut_x[i], y = lut_y[i];
-        r[u + 1] = {
-            r[u].w + wt,           r[u].wx + wt * x,      r[u].wy + wt * y,  r[u].wxx + wt * x * x,
-            r[u].wxy + wt * x * y, r[u].wyy + wt * y * y, r[u].ww + wt * wt, r[u].n + 1};
+        running.add(lut_w[i], lut_x[i], lut_y[i]);
       }
+      if (w % kSumStride == 0) r[w / kSumStride] = running;
     }
     const double face =
         prior.rectangle ? prior.length * prior.width : M_PI / 4 * prior.length * prior.length;
@@ -462,23 +479,24 @@ Moments LampDetector::Impl::moments(const detail::Blob& c, int pad, int mw) cons
   // Each run of the opened mask adds the difference of its row's running sums at its ends. A
   // pixel is a small square, not a point: its own spread adds wt^2 / 12 to each axis.
   RowSums s;
+  long pixels = 0;
   const int n = c.u1 - c.u0 + 1;
   for (int v = c.v0; v <= c.v1; ++v) {
     const std::uint8_t* in = opened.data() + static_cast<std::size_t>(v - c.v0 + pad) * mw + pad;
-    const RowSums* r = row_sums.data() + static_cast<std::size_t>(w + 1) * v + c.u0;
     for (int k = 0; k < n;) {
       k = skip_while(in, k, n, 0);
       if (k == n) break;
       const int end = skip_while(in, k, n, 1);
-      const RowSums &a = r[k], &b = r[end];
+      const RowSums a = sums_before(c.u0 + k, v), b = sums_before(c.u0 + end, v);
       s.w += b.w - a.w, s.wx += b.wx - a.wx, s.wy += b.wy - a.wy;
       s.wxx += b.wxx - a.wxx, s.wxy += b.wxy - a.wxy, s.wyy += b.wyy - a.wyy;
-      s.ww += b.ww - a.ww, s.n += b.n - a.n;
+      s.ww += b.ww - a.ww;
+      pixels += end - k;
       k = end;
     }
   }
   Moments m;
-  m.pixels = static_cast<int>(std::lround(s.n));
+  m.pixels = static_cast<int>(pixels);
   m.m0 = s.w;
   if (m.pixels == 0 || s.w <= 0) return m;
   m.cx = s.wx / s.w;
