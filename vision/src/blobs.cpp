@@ -11,36 +11,26 @@ namespace lampnav::vision::detail {
 
 namespace {
 
-// The first column from u on whose 16-pixel (SSE2) or 8-pixel block holds a pixel >= t, or the
-// first of the last short block: the ceiling is mostly dark, so most of a row is passed over here.
-int skip_dark(const std::uint8_t* row, int u, int w, std::uint8_t t) {
+// The first column from u on whose pixel is bright (>= t) when `bright` is true, or dark when it
+// is false; w if none. Whole blocks of the other kind are passed over 16 pixels at a time (SSE2;
+// 8 elsewhere): the ceiling is mostly dark, and a lamp's rows are long bright runs.
+int next_column(const std::uint8_t* row, int u, int w, std::uint8_t t, bool bright) {
 #if defined(__SSE2__)
   const __m128i threshold = _mm_set1_epi8(static_cast<char>(t));
+  const int passed = bright ? 0 : 0xFFFF;  // the block's bright mask when all of it is passed
   for (; u + 16 <= w; u += 16) {
     const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + u));
     // max(x, t) == x exactly where x >= t (unsigned).
-    if (_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_max_epu8(x, threshold), x)) != 0) break;
+    if (_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_max_epu8(x, threshold), x)) != passed) break;
   }
 #else
   for (; u + 8 <= w; u += 8) {
-    bool any = false;
-    for (int k = 0; k < 8; ++k) any |= row[u + k] >= t;
-    if (any) break;
+    bool found = false;
+    for (int k = 0; k < 8; ++k) found |= (row[u + k] >= t) == bright;
+    if (found) break;
   }
 #endif
-  return u;
-}
-
-// The first column from u on that is below t, or w: a lamp's rows are long bright runs.
-int skip_bright(const std::uint8_t* row, int u, int w, std::uint8_t t) {
-#if defined(__SSE2__)
-  const __m128i threshold = _mm_set1_epi8(static_cast<char>(t));
-  for (; u + 16 <= w; u += 16) {
-    const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + u));
-    if (_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_max_epu8(x, threshold), x)) != 0xFFFF) break;
-  }
-#endif
-  while (u < w && row[u] >= t) ++u;
+  while (u < w && (row[u] >= t) != bright) ++u;
   return u;
 }
 
@@ -76,11 +66,10 @@ void BlobLabeller::label(const ImageView& g, std::uint8_t t, const PixelBox& req
     const int cur_begin = static_cast<int>(runs_.size());
     int u = 0;
     while (u < w) {
-      u = skip_dark(in, u, w, t);
-      while (u < w && in[u] < t) ++u;
+      u = next_column(in, u, w, t, true);
       if (u >= w) break;
       const int start = u;
-      u = skip_bright(in, u, w, t);
+      u = next_column(in, u, w, t, false);
       const int id = static_cast<int>(runs_.size());
       runs_.push_back({v + dv, start + du, u - 1 + du, id});
     }
