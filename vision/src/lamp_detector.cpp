@@ -10,6 +10,7 @@
 #include "blobs.hpp"
 #include "lampnav/core/pose2.hpp"
 #include "lampnav/vision/camera_models.hpp"
+#include "run_mask.hpp"
 
 namespace lampnav::vision {
 
@@ -128,52 +129,6 @@ ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Ve
   return fit;
 }
 
-// Morphological opening (erosion, then dilation) of a 0/1 mask by a (2r+1)^2 square, done as
-// separable running minima and maxima over rows, then columns. Pixels within r of the mask's own
-// edge are treated as outside; the caller pads the mask by more than r.
-void open_mask(const std::vector<std::uint8_t>& in, int w, int h, int r,
-               std::vector<std::uint8_t>& out, std::vector<std::uint8_t>& tmp) {
-  out.assign(in.size(), 0);
-  tmp.assign(in.size(), 0);
-  // Along rows: dst[k] = AND (or OR) of src[k - r .. k + r], for k with the whole window inside.
-  auto rows = [&](const std::uint8_t* src, std::uint8_t* dst, bool erode) {
-    for (int y = 0; y < h; ++y) {
-      const std::uint8_t* a = src + static_cast<std::size_t>(y) * w;
-      std::uint8_t* d = dst + static_cast<std::size_t>(y) * w;
-      std::memset(d, 0, static_cast<std::size_t>(w));
-      std::memcpy(d + r, a, static_cast<std::size_t>(w - 2 * r));  // window start a[k - r]
-      for (int j = -r + 1; j <= r; ++j) {
-        const std::uint8_t* b = a + r + j;
-        if (erode) {
-          for (int k = r; k < w - r; ++k) d[k] &= b[k - r];
-        } else {
-          for (int k = r; k < w - r; ++k) d[k] |= b[k - r];
-        }
-      }
-    }
-  };
-  // Along columns, whole rows at a time (vectorizable).
-  auto cols = [&](const std::uint8_t* src, std::uint8_t* dst, bool erode) {
-    std::memset(dst, 0, static_cast<std::size_t>(w) * h);
-    for (int y = r; y < h - r; ++y) {
-      std::uint8_t* d = dst + static_cast<std::size_t>(y) * w;
-      std::memcpy(d, src + static_cast<std::size_t>(y - r) * w, static_cast<std::size_t>(w));
-      for (int j = -r + 1; j <= r; ++j) {
-        const std::uint8_t* a = src + static_cast<std::size_t>(y + j) * w;
-        if (erode) {
-          for (int k = 0; k < w; ++k) d[k] &= a[k];
-        } else {
-          for (int k = 0; k < w; ++k) d[k] |= a[k];
-        }
-      }
-    }
-  };
-  rows(in.data(), tmp.data(), true);
-  cols(tmp.data(), out.data(), true);  // eroded
-  rows(out.data(), tmp.data(), false);
-  cols(tmp.data(), out.data(), false);  // opened
-}
-
 }  // namespace
 
 const char* to_string(LampView view) {
@@ -250,7 +205,9 @@ struct LampDetector::Impl {
   // Scratch, reused frame to frame.
   std::vector<std::uint8_t> grey;
   detail::BlobLabeller blobs;
-  std::vector<std::uint8_t> mask, opened, scratch;
+  detail::RunMask mask_runs, opened_runs;
+  detail::RunOpening opening;
+  std::vector<std::uint8_t> opened;
   EdgePoints edges;
   std::vector<char> fit_use;  // fit_shape: which edge points are still in the fit
 
@@ -307,7 +264,7 @@ struct LampDetector::Impl {
   bool complete(const detail::Blob& c, const ImageView& g, int pad, LampDetection& out);
   // Of the opened mask of blob `c` (padded by `pad`, `mw` wide): its moments, the pixel nearest
   // the middle of its box, and whether it reaches the image's border.
-  Moments moments(const detail::Blob& c, int pad, int mw) const;
+  Moments moments(const detail::Blob& c, int pad, const detail::RunMask& open) const;
   std::array<int, 2> seed_near_middle(const detail::Blob& c, int pad, int mw) const;
   bool touches_image_border(const detail::Blob& c, int pad, int mw) const;
 };
@@ -387,38 +344,48 @@ bool LampDetector::Impl::measure_blobs(const ImageView& g, const PixelBox& box,
 
 bool LampDetector::Impl::measure(const detail::Blob& c, const ImageView& g, LampDetection& out,
                                  DetectionStats& st) {
-  // The component's mask with a margin; on sides where the lamp leaves the image the mask is
-  // continued outwards so that the opening does not eat the cut edge.
+  // The component's mask with a margin, as runs; on sides where the lamp leaves the image the
+  // mask is continued outwards so that the opening does not eat the cut edge.
   const int r = o.opening_radius, pad = 2 * r + 1;
   const int mw = c.u1 - c.u0 + 1 + 2 * pad, mh = c.v1 - c.v0 + 1 + 2 * pad;
-  mask.assign(static_cast<std::size_t>(mw) * mh, 0);
-  auto mrow = [&](std::vector<std::uint8_t>& m, int y) {
-    return m.data() + static_cast<std::size_t>(y) * mw;
+  const bool extend = r > 0;
+  const bool cut_left = extend && c.u0 == 0, cut_right = extend && c.u1 == w - 1;
+  const bool cut_top = extend && c.v0 == 0, cut_bottom = extend && c.v1 == h - 1;
+  // Row y of the padded mask: the blob's runs of its row, or a copy of the first or last.
+  int next_run = 0;
+  auto add_blob_row = [&](int y) {
+    const int v = y - pad + c.v0;
+    while (next_run < c.run_count && blobs.run(c.first_run + next_run).row < v) ++next_run;
+    for (int j = next_run; j < c.run_count && blobs.run(c.first_run + j).row == v; ++j) {
+      const detail::Run& run = blobs.run(c.first_run + j);
+      int a = run.u0 - c.u0 + pad, b = run.u1 - c.u0 + pad;
+      if (cut_left && a == pad) a = 0;
+      if (cut_right && b == mw - pad - 1) b = mw - 1;
+      mask_runs.add(a, b);
+    }
   };
-  for (int k = 0; k < c.run_count; ++k) {
-    const detail::Run& run = blobs.run(c.first_run + k);
-    std::memset(mrow(mask, run.row - c.v0 + pad) + (run.u0 - c.u0 + pad), 1,
-                static_cast<std::size_t>(run.u1 - run.u0 + 1));
-  }
-  const bool cut_left = c.u0 == 0, cut_right = c.u1 == w - 1;
-  const bool cut_top = c.v0 == 0, cut_bottom = c.v1 == h - 1;
-  if (r > 0) {
-    for (int y = pad; y < mh - pad; ++y) {
-      std::uint8_t* row = mrow(mask, y);
-      if (cut_left) std::memset(row, row[pad], static_cast<std::size_t>(pad));
-      if (cut_right) std::memset(row + mw - pad, row[mw - pad - 1], static_cast<std::size_t>(pad));
+  mask_runs.reset(mw, mh);
+  for (int y = 0; y < mh; ++y) {
+    mask_runs.begin_row();
+    if (y < pad) {
+      if (cut_top) add_blob_row(pad);
+    } else if (y >= mh - pad) {
+      if (cut_bottom) add_blob_row(mh - pad - 1);
+    } else {
+      add_blob_row(y);
     }
-    for (int y = 0; y < pad; ++y) {
-      if (cut_top) std::memcpy(mrow(mask, y), mrow(mask, pad), static_cast<std::size_t>(mw));
-      if (cut_bottom)
-        std::memcpy(mrow(mask, mh - 1 - y), mrow(mask, mh - pad - 1), static_cast<std::size_t>(mw));
-    }
-    open_mask(mask, mw, mh, r, opened, scratch);
-  } else {
-    opened = mask;
   }
+  mask_runs.end_rows();
+  if (r > 0) opening.open(mask_runs, r, opened_runs);
+  const detail::RunMask& open_runs = r > 0 ? opened_runs : mask_runs;
+  // The opened mask as bytes too, for the seed, the border test and completion's edges.
+  opened.assign(static_cast<std::size_t>(mw) * mh, 0);
+  for (int y = 0; y < mh; ++y)
+    for (const detail::Span* sp = open_runs.row_begin(y); sp != open_runs.row_end(y); ++sp)
+      std::memset(opened.data() + static_cast<std::size_t>(y) * mw + sp->a, 1,
+                  static_cast<std::size_t>(sp->b - sp->a + 1));
   // Moments in undistorted normalized coordinates, each pixel weighted by the area it covers.
-  const Moments m = moments(c, pad, mw);
+  const Moments m = moments(c, pad, open_runs);
   if (m.pixels == 0 || m.m0 <= 0) {
     ++st.too_small;
     return false;
@@ -475,24 +442,24 @@ bool LampDetector::Impl::measure(const detail::Blob& c, const ImageView& g, Lamp
   return true;
 }
 
-Moments LampDetector::Impl::moments(const detail::Blob& c, int pad, int mw) const {
-  // Each run of the opened mask adds the difference of its row's running sums at its ends. A
-  // pixel is a small square, not a point: its own spread adds wt^2 / 12 to each axis.
+Moments LampDetector::Impl::moments(const detail::Blob& c, int pad,
+                                    const detail::RunMask& open) const {
+  // Each run of the opened mask inside the blob's box adds the difference of its row's running
+  // sums at its ends. A pixel is a small square, not a point: its own spread adds wt^2 / 12 to
+  // each axis.
   RowSums s;
   long pixels = 0;
   const int n = c.u1 - c.u0 + 1;
   for (int v = c.v0; v <= c.v1; ++v) {
-    const std::uint8_t* in = opened.data() + static_cast<std::size_t>(v - c.v0 + pad) * mw + pad;
-    for (int k = 0; k < n;) {
-      k = skip_while(in, k, n, 0);
-      if (k == n) break;
-      const int end = skip_while(in, k, n, 1);
-      const RowSums a = sums_before(c.u0 + k, v), b = sums_before(c.u0 + end, v);
-      s.w += b.w - a.w, s.wx += b.wx - a.wx, s.wy += b.wy - a.wy;
-      s.wxx += b.wxx - a.wxx, s.wxy += b.wxy - a.wxy, s.wyy += b.wyy - a.wyy;
-      s.ww += b.ww - a.ww;
-      pixels += end - k;
-      k = end;
+    const int y = v - c.v0 + pad;
+    for (const detail::Span* sp = open.row_begin(y); sp != open.row_end(y); ++sp) {
+      const int a = std::max(sp->a - pad, 0), end = std::min(sp->b - pad + 1, n);
+      if (a >= end) continue;
+      const RowSums lo = sums_before(c.u0 + a, v), hi = sums_before(c.u0 + end, v);
+      s.w += hi.w - lo.w, s.wx += hi.wx - lo.wx, s.wy += hi.wy - lo.wy;
+      s.wxx += hi.wxx - lo.wxx, s.wxy += hi.wxy - lo.wxy, s.wyy += hi.wyy - lo.wyy;
+      s.ww += hi.ww - lo.ww;
+      pixels += end - a;
     }
   }
   Moments m;

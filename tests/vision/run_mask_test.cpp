@@ -1,0 +1,109 @@
+// The lamp detector's opening on runs (vision/src/run_mask.hpp, white-box), against the opening
+// written pixel by pixel from its definition: erosion then dilation by a (2r+1)^2 square, pixels
+// within r of the mask's edge outside. Random masks of every density and size, r = 1 to 3.
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "run_mask.hpp"
+
+namespace lampnav::vision::detail {
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+
+// One pass of the definition along rows (dx) or columns (dy): AND or OR over the 2r+1 pixels
+// around, for pixels whose window lies inside; 0 elsewhere.
+Bytes pass(const Bytes& in, int w, int h, int r, bool erode, bool rows) {
+  Bytes out(in.size(), 0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const int at = rows ? x : y, n = rows ? w : h;
+      if (at < r || at >= n - r) continue;
+      bool all = true, any = false;
+      for (int j = -r; j <= r; ++j) {
+        const bool set = rows ? in[static_cast<std::size_t>(y) * w + x + j]
+                              : in[static_cast<std::size_t>(y + j) * w + x];
+        all &= set;
+        any |= set;
+      }
+      out[static_cast<std::size_t>(y) * w + x] = (erode ? all : any) ? 1 : 0;
+    }
+  }
+  return out;
+}
+
+Bytes opened_by_definition(const Bytes& in, int w, int h, int r) {
+  const Bytes eroded = pass(pass(in, w, h, r, true, true), w, h, r, true, false);
+  return pass(pass(eroded, w, h, r, false, true), w, h, r, false, false);
+}
+
+RunMask runs_of(const Bytes& m, int w, int h) {
+  RunMask out;
+  out.reset(w, h);
+  for (int y = 0; y < h; ++y) {
+    out.begin_row();
+    for (int x = 0; x < w;) {
+      if (!m[static_cast<std::size_t>(y) * w + x]) {
+        ++x;
+        continue;
+      }
+      const int a = x;
+      while (x < w && m[static_cast<std::size_t>(y) * w + x]) ++x;
+      out.add(a, x - 1);
+    }
+  }
+  out.end_rows();
+  return out;
+}
+
+Bytes bytes_of(const RunMask& m) {
+  Bytes out(static_cast<std::size_t>(m.width()) * m.height(), 0);
+  for (int y = 0; y < m.height(); ++y) {
+    int last = -2;
+    for (const Span* s = m.row_begin(y); s != m.row_end(y); ++s) {
+      EXPECT_LE(s->a, s->b) << "row " << y;
+      EXPECT_GT(s->a, last + 1) << "row " << y << ": spans not sorted, apart and joined";
+      last = s->b;
+      for (int x = s->a; x <= s->b; ++x) out[static_cast<std::size_t>(y) * m.width() + x] = 1;
+    }
+  }
+  return out;
+}
+
+TEST(RunOpening, SamePixelsAsTheOpeningByDefinition) {
+  std::mt19937 rng(7);
+  RunOpening opening;  // one, so that its scratch is reused from case to case
+  RunMask out;
+  int cases = 0, changed = 0;
+  for (int r = 1; r <= 3; ++r) {
+    for (const double density : {0.1, 0.5, 0.8, 0.95, 1.0}) {
+      for (int trial = 0; trial < 12; ++trial) {
+        const int w = 1 + static_cast<int>(rng() % 40), h = 1 + static_cast<int>(rng() % 30);
+        // Blocks of random size, so that runs and holes of every length occur.
+        Bytes m(static_cast<std::size_t>(w) * h, 0);
+        std::bernoulli_distribution on(density);
+        for (int y = 0; y < h; ++y)
+          for (int x = 0; x < w;) {
+            const int len = 1 + static_cast<int>(rng() % 6);
+            const std::uint8_t v = on(rng) ? 1 : 0;
+            for (int k = 0; k < len && x < w; ++k, ++x) m[static_cast<std::size_t>(y) * w + x] = v;
+          }
+        const Bytes expected = opened_by_definition(m, w, h, r);
+        opening.open(runs_of(m, w, h), r, out);
+        ASSERT_EQ(out.width(), w);
+        ASSERT_EQ(out.height(), h);
+        ASSERT_EQ(bytes_of(out), expected) << "r " << r << ", " << w << " x " << h;
+        ++cases;
+        changed += expected != m ? 1 : 0;
+      }
+    }
+  }
+  EXPECT_EQ(cases, 180);
+  EXPECT_GT(changed, 150);  // the opening did something in most cases
+}
+
+}  // namespace
+}  // namespace lampnav::vision::detail
