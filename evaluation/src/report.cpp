@@ -186,9 +186,16 @@ std::string line_chart(const std::vector<Series>& series, const std::string& x_l
   return s.str();
 }
 
+// A place on the map where something happened: a kidnap (red) or a relocalization (green).
+struct Mark {
+  enum class Kind { kidnap, relocalized };
+  Eigen::Vector2d at;
+  Kind kind;
+};
+
 // The map with regions, axes, lamps, names and trajectories.
 std::string map_figure(const graph::TopologicalMap& map, const std::vector<Series>& paths,
-                       const std::vector<std::pair<Eigen::Vector2d, std::string>>& marks) {
+                       const std::vector<Mark>& marks) {
   Eigen::Vector2d lo(1e18, 1e18), hi(-1e18, -1e18);
   for (const auto& n : map.nodes()) {
     for (const auto& v : n.region.vertices()) {
@@ -237,10 +244,13 @@ std::string map_figure(const graph::TopologicalMap& map, const std::vector<Serie
       << "\" y=\"" << pad + 6 + 16 * legend << "\">" << escape(p.name) << "</text>\n";
     ++legend;
   }
-  for (const auto& [p, what] : marks)
-    s << "<circle cx=\"" << X(p.x()) << "\" cy=\"" << Y(p.y())
-      << "\" r=\"6\" fill=\"none\" stroke=\"" << (what == "kidnap" ? "#d62728" : "#2ca02c")
-      << "\" stroke-width=\"2\"><title>" << escape(what) << "</title></circle>\n";
+  for (const Mark& m : marks) {
+    const bool kidnap = m.kind == Mark::Kind::kidnap;
+    s << "<circle cx=\"" << X(m.at.x()) << "\" cy=\"" << Y(m.at.y())
+      << "\" r=\"6\" fill=\"none\" stroke=\"" << (kidnap ? "#d62728" : "#2ca02c")
+      << "\" stroke-width=\"2\"><title>" << (kidnap ? "kidnap" : "relocalized")
+      << "</title></circle>\n";
+  }
   s << "</svg>\n";
   return s.str();
 }
@@ -295,16 +305,16 @@ std::vector<Figure> report_figures(const ReplayResult& r, const io::MissionLog& 
     }
     fused.points.emplace_back(e.pose.x(), e.pose.y());
   }
-  std::vector<std::pair<Eigen::Vector2d, std::string>> marks;
+  std::vector<Mark> marks;
   for (const auto& e : log.events)
     if (e.value.type() == io::EventKind::kidnap && !truth.empty())
-      marks.emplace_back(truth.at(e.value.stamp + std::chrono::milliseconds(1)).translation(),
-                         "kidnap");
+      marks.push_back({truth.at(e.value.stamp + std::chrono::milliseconds(1)).translation(),
+                       Mark::Kind::kidnap});
   for (const auto& e : r.events)
     if (e.mode == fusion::LocalizerMode::relocalized)
       for (const auto& s : r.estimates)
         if (s.stamp > e.stamp) {
-          marks.emplace_back(s.pose.translation(), "relocalized");
+          marks.push_back({s.pose.translation(), Mark::Kind::relocalized});
           break;
         }
   std::vector<Figure> figs;
