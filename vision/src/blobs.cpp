@@ -9,8 +9,6 @@
 
 namespace lampnav::vision::detail {
 
-namespace {
-
 // The first column from u on whose pixel is bright (>= t) when `bright` is true, or dark when it
 // is false; w if none. Whole blocks of the other kind are passed over 16 pixels at a time (SSE2;
 // 8 elsewhere): the ceiling is mostly dark, and a lamp's rows are long bright runs.
@@ -33,8 +31,6 @@ int next_column(const std::uint8_t* row, int u, int w, std::uint8_t t, bool brig
   while (u < w && (row[u] >= t) != bright) ++u;
   return u;
 }
-
-}  // namespace
 
 int BlobLabeller::find_root(int i) {
   while (runs_[i].parent != i) {

@@ -22,6 +22,10 @@ struct Blob {
   int first_run = 0, run_count = 0;                  // into BlobLabeller::blob_runs()
 };
 
+// The first column from u on (below w) whose pixel is bright (>= t) when `bright` is true, or
+// dark when it is false; w if none. Also finds runs in a 0/1 mask (t = 1).
+int next_column(const std::uint8_t* row, int u, int w, std::uint8_t t, bool bright);
+
 class BlobLabeller {
  public:
   // Labels the pixels >= `threshold` of an 8-bit grey image of width x height. The scratch is

@@ -22,18 +22,6 @@ void require(bool ok, const char* what, const char* field, const std::string& me
   if (!ok) throw InputError({"", what, field}, message);
 }
 
-// The first k' >= k with row[k'] != value (n if none), for a row of 0/1 bytes: eight at a time
-// while they all equal `value`.
-int skip_while(const std::uint8_t* row, int k, int n, std::uint8_t value) {
-  const std::uint64_t all = value ? 0x0101010101010101ull : 0;
-  for (std::uint64_t word; k + 8 <= n; k += 8) {
-    std::memcpy(&word, row + k, 8);
-    if (word != all) break;
-  }
-  while (k < n && row[k] == value) ++k;
-  return k;
-}
-
 // A blob's weighted area, centroid and central second moments (each pixel a small square).
 struct Moments {
   double m0 = 0, cx = 0, cy = 0, mu20 = 0, mu02 = 0, mu11 = 0;
@@ -533,9 +521,9 @@ bool LampDetector::Impl::complete(const detail::Blob& c, const ImageView& g, int
     const std::uint8_t* grey_row = g.data + static_cast<std::size_t>(v) * stride;
     const bool border_row = v == 0 || v == h - 1;
     const int n = c.u1 - c.u0 + 1;
-    for (int j = skip_while(row, 0, n, 0); j < n;) {
+    for (int j = detail::next_column(row, 0, n, 1, true); j < n;) {
       if (!row[j]) {
-        j = skip_while(row, j, n, 0);
+        j = detail::next_column(row, j, n, 1, true);
         continue;
       }
       // Eight pixels inside a run whose neighbours above and below are all set have no edge

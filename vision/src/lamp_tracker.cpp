@@ -54,6 +54,7 @@ struct LampTracker::Impl {
   int next_id = 1;
   int since_whole = 1 << 20;  // frames since the last frame read whole; huge: read the next whole
   std::vector<std::uint8_t> grey;
+  mutable std::vector<std::pair<int, int>> covered;  // ring_unexplained: [a, b] along a side
 
   Impl(const CameraDescription& camera, const LampShapePrior& prior,
        const LampDetectorOptions& detector_options, const LampTrackerOptions& options)
@@ -113,7 +114,6 @@ bool LampTracker::Impl::ring_unexplained(const ImageView& g,
   const std::size_t stride = g.row_stride();
   // One side of the ring: `n` pixels from `first`, `step` apart, at positions 0..n-1 along it.
   // The parts inside a box are explained; the rest is read until a bright pixel.
-  std::vector<std::pair<int, int>> covered;  // [a, b] along the side
   auto side = [&](const std::uint8_t* first, std::size_t step, int n, auto box_span) {
     covered.clear();
     for (const PixelBox& b : boxes)
