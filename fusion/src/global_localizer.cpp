@@ -573,11 +573,10 @@ GlobalLocalization GlobalLocalizer::locate(const vision::OmniDetection& d,
 }
 
 GlobalLocalization GlobalLocalizer::enumerate(const vision::OmniDetection& d, int cap,
-                                              double margin) const {
+                                              double margin, const EnumerationPrior* prior) const {
   const Impl& m = *impl_;
-  GlobalLocalization out;
   if (d.flooded || m.lamps.empty() || d.blobs.empty()) return locate(d, GlobalMethod::lamp_pairs);
-  return m.exhaustive(d, std::max(1, cap), std::max(0.0, margin));
+  return m.exhaustive(d, std::max(1, cap), std::max(0.0, margin), prior);
 }
 
 GlobalLocalizer::PoseScore GlobalLocalizer::score(const Pose2& pose, double position_sigma,

@@ -231,7 +231,8 @@ struct GlobalLocalizer::Impl {
                                 int max_hypotheses) const;
 
   // Every pose the lamps nearest the optical axis allow (global_localizer.hpp, enumerate()).
-  GlobalLocalization exhaustive(const vision::OmniDetection& d, int cap, double margin) const;
+  GlobalLocalization exhaustive(const vision::OmniDetection& d, int cap, double margin,
+                                const EnumerationPrior* prior) const;
 
   // Ranks, merges near-duplicates, weighs, places on the graph, and says whether it is ambiguous.
   void finish(GlobalLocalization& out, std::vector<PoseHypothesis> hs,

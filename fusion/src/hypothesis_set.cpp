@@ -12,6 +12,7 @@
 #include "lampnav/core/parallel.hpp"
 #include "lampnav/fusion/ceiling_geometry.hpp"
 #include "lampnav/vision/camera_models.hpp"
+#include "pose_grid.hpp"
 
 namespace lampnav::fusion {
 
@@ -47,6 +48,8 @@ void HypothesisSetOptions::validate() const {
   check(publish_ratio >= 1, "publish_ratio", "must be at least 1");
   check(min_omni_frames >= 1, "min_omni_frames", "must be at least 1");
   check(max_hypotheses >= 1 && max_hypotheses <= 100000, "max_hypotheses", "must be 1 to 100000");
+  check(place_gate_m > 0 && place_gate_deg > 0, "place_gate_m", "must be positive");
+  check(place_cost_max >= frame_cost_cap, "place_cost_max", "must be at least frame_cost_cap");
   check(drop_ratio > 0 && drop_ratio < 1e-3, "drop_ratio", "must be in (0, 0.001)");
   check(birth_ratio >= drop_ratio && birth_ratio < 1, "birth_ratio", "must be in [drop_ratio, 1)");
   check(symmetry_check_max >= 2, "symmetry_check_max", "must be at least 2");
@@ -83,7 +86,17 @@ struct HypothesisSet::Impl {
   std::string last_why = "no omni image yet";
   Counts counts;
   std::optional<std::pair<Stamp, Pose2>> last_enumeration;  // capture, dead-reckoned pose
-  mutable std::map<std::pair<int, int>, bool> twin_cache;   // by hypothesis ids
+  // While incomplete: every coarse place the images so far allow, where the last image that
+  // allowed it put it (carry_places).
+  struct Place {
+    Pose2 pose;
+    Stamp stamp;
+    Pose2 odometry;     // dead-reckoned at stamp
+    double travel = 0;  // since an image last allowed it (m)
+    double cost = 0;    // -2 ln L of the drive so far, relative to the likeliest place
+  };
+  std::vector<Place> places;
+  mutable std::map<std::pair<int, int>, bool> twin_cache;  // by hypothesis ids
 
   // Whether the rigid motion taking pose a to pose b maps every lamp of the map onto a lamp of
   // the same shape and size (a rectangle's axis modulo a half turn): then the two places look
@@ -356,15 +369,80 @@ struct HypothesisSet::Impl {
     return h;
   }
 
+  // The places carried to `stamp` (those gone through a wall left behind), and the gate an
+  // image's poses must fall within to be one of them.
+  EnumerationPrior carry_places(Stamp stamp, const OdometryTrack& odo) {
+    EnumerationPrior prior;
+    std::vector<Place> kept;
+    double travel = 0;
+    for (Place p : places) {
+      p.travel += odo.travel(p.stamp, stamp);
+      const Pose2 at = odo.at(stamp);
+      p.pose = p.pose * p.odometry.between(at);
+      p.odometry = at;
+      p.stamp = stamp;
+      if (!inside(p.pose)) continue;
+      travel = std::max(travel, p.travel);
+      prior.poses.push_back(p.pose);
+      prior.costs.push_back(p.cost);
+      kept.push_back(p);
+    }
+    places = std::move(kept);
+    prior.gate_m = o.place_gate_m + 3 * o.sigma_per_m * travel;
+    prior.gate_rad = (o.place_gate_deg + 3 * o.sigma_yaw_deg_per_m * travel) * kDeg;
+    prior.view_cost_cap = o.frame_cost_cap;
+    prior.cost_max = o.place_cost_max;
+    return prior;
+  }
+
+  // After an image's enumeration: its places, and the carried ones it did not allow at all,
+  // at the cost of one image's cap, while the drive still allows them. Returns the latter.
+  std::vector<Place> update_places(const GlobalLocalization& r, const EnumerationPrior* prior,
+                                   Stamp stamp, const OdometryTrack& odo) {
+    std::vector<Place> next, missed;
+    const Pose2 at = odo.at(stamp);
+    for (std::size_t k = 0; k < r.candidates.size(); ++k)
+      next.push_back(
+          {r.candidates[k], stamp, at, 0.0,
+           prior ? r.candidate_costs[k] : std::min(o.frame_cost_cap, r.candidate_costs[k])});
+    if (prior) {
+      const detail::PoseGrid allowed(r.candidates, prior->gate_m);
+      for (Place p : places) {
+        if (allowed.near(p.pose, prior->gate_m, prior->gate_rad)) continue;
+        p.cost += o.frame_cost_cap;
+        if (p.cost > o.place_cost_max) continue;
+        next.push_back(p);
+        missed.push_back(p);
+      }
+    }
+    places = std::move(next);
+    return missed;
+  }
+
   // Births from one image's enumeration. A complete one starts the set again from every place
   // it found, weighed by the image (the kept estimate, if still alive, keeps its prior share and
   // what this image said of it, capped); an incomplete one shows the places found, weighed by
-  // this image alone, beside the kept estimate (omni() removed the previous image's).
+  // this image alone, beside the kept estimate (omni() removed the previous image's). While
+  // incomplete, each enumeration considers only the places the images before it allowed.
   void births(Stamp stamp, const vision::OmniDetection& d, const OdometryTrack& odo) {
     last_enumeration = {stamp, odo.at(stamp)};
     ++counts.enumerations;
     const double margin = -2 * std::log(o.birth_ratio);
-    const GlobalLocalization r = omni->enumerate(d, o.max_hypotheses, margin);
+    const EnumerationPrior prior = o.carry_places ? carry_places(stamp, odo) : EnumerationPrior{};
+    const bool with_prior = !prior.poses.empty();
+    GlobalLocalization r =
+        omni->enumerate(d, o.max_hypotheses, margin, with_prior ? &prior : nullptr);
+    std::vector<Place> missed;
+    if (o.carry_places && (r.found() || r.seeds >= 2)) {
+      missed = update_places(r, with_prior ? &prior : nullptr, stamp, odo);
+      if (with_prior && places.empty()) {
+        // No place the drive allowed fits this image twice running: the places were lost (or
+        // the robot carried away); start again from this image alone.
+        ++counts.place_restarts;
+        r = omni->enumerate(d, o.max_hypotheses, margin);
+        missed = update_places(r, nullptr, stamp, odo);
+      }
+    }
     if (!r.found()) {
       last_why = r.why;
       return;
@@ -373,7 +451,9 @@ struct HypothesisSet::Impl {
     const double best_score = r.hypotheses.front().score;
     std::size_t n = 0;
     while (n < r.hypotheses.size() && r.hypotheses[n].score <= best_score + margin) ++n;
-    if (r.complete) {
+    // A place of the drive this image alone did not allow still counts until a second image
+    // agrees: one odd image (a lamp hidden) never removes the truth. Then it is a hypothesis.
+    if (r.complete && n + missed.size() <= std::size_t(o.max_hypotheses)) {
       ++counts.complete_enumerations;
       std::vector<Hypothesis> next;
       double kept_share = 0;
@@ -384,12 +464,24 @@ struct HypothesisSet::Impl {
               std::log(o.kept_prior) - 0.5 * std::min(o.frame_cost_cap, h.last_cost - best_score);
           kept_share = o.kept_prior;
         }
-      const double each = std::log((1 - kept_share) / double(std::max(1, r.plausible)));
+      const double each = std::log((1 - kept_share) /
+                                   double(std::max<std::size_t>(1, r.plausible + missed.size())));
       for (std::size_t k = 0; k < n; ++k)
         next.push_back(
             born(r.hypotheses[k], stamp, odo, each - 0.5 * (r.hypotheses[k].score - best_score)));
+      for (const Place& p : missed) {
+        PoseHypothesis coarse;
+        coarse.pose = p.pose;
+        coarse.covariance =
+            Eigen::Vector3d(std::pow(prior.gate_m / 2, 2), std::pow(prior.gate_m / 2, 2),
+                            std::pow(prior.gate_rad / 2, 2))
+                .asDiagonal();
+        coarse.node = map->node_containing(p.pose.translation());
+        next.push_back(born(coarse, stamp, odo, each - 0.5 * p.cost));
+      }
       hs = std::move(next);
       complete = true;
+      places.clear();
       last_enumeration.reset();
       omni_frames = 1;  // this image weighed them
       last_why.clear();
@@ -412,6 +504,7 @@ struct HypothesisSet::Impl {
   void reset(const std::string& why) {
     ++counts.resets;
     last_enumeration.reset();
+    places.clear();
     hs.clear();
     complete = false;
     omni_frames = 0;
@@ -434,6 +527,7 @@ void HypothesisSet::clear() {
   m.omni_frames = 0;
   m.twin_cache.clear();
   m.last_enumeration.reset();
+  m.places.clear();
   m.last_why = "no omni image yet";
 }
 

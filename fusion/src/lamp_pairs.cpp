@@ -4,10 +4,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <optional>
 #include <unordered_map>
 
 #include "global_localizer_impl.hpp"
 #include "lampnav/core/parallel.hpp"
+#include "pose_grid.hpp"
 #include "spurious_blobs.hpp"
 
 namespace lampnav::fusion {
@@ -182,7 +185,8 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
 // cannot hide the true pose. The other seeds must mostly land on lamps too (a cheap check
 // through the map's spatial index) before a pose is scored; the plausible ones are refined.
 GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection& d, int cap,
-                                                     double margin) const {
+                                                     double margin,
+                                                     const EnumerationPrior* prior) const {
   const LampPairOptions& q = o.pairs;
   GlobalLocalization out;
   out.method = GlobalMethod::lamp_pairs;
@@ -190,6 +194,7 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   out.blobs = static_cast<int>(blobs.size());
   const Seeds seeds = seeds_of(blobs, q, 6);
   const std::size_t ns = seeds.size(), nc = classes.size();
+  out.seeds = static_cast<int>(ns);
   if (ns < 2) {
     out.why = too_few_seeds(ns, q);
     return out;
@@ -204,15 +209,24 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   std::vector<BlobRay> near;
   for (const BlobRay& b : blobs)
     if (b.theta <= screen) near.push_back(b);
-  // In the graph, and the other seeds on lamps (all but one of them).
+  // Near a place an earlier image allowed, in the graph, and the other seeds on lamps (all but
+  // one of them).
+  std::optional<PoseGrid> allowed;
+  if (prior)
+    allowed.emplace(prior->poses, prior->gate_m,
+                    prior->costs.size() == prior->poses.size() ? &prior->costs : nullptr);
   std::vector<std::pair<std::int64_t, Pose2>> poses(cells.begin(), cells.end());
   std::sort(poses.begin(), poses.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
   // Each pose screened alone (on every core), kept in the order of its cell.
-  std::vector<double> screened(poses.size(), 0.0);
+  std::vector<double> screened(poses.size(), 0.0), before(poses.size(), 0.0);
   std::vector<char> passed(poses.size(), 0);
   for_each_costly_index(poses.size(), serial_up_to(16), [&](std::size_t i) {
     const Pose2& pose = poses[i].second;
+    if (allowed) {
+      before[i] = allowed->least(pose, prior->gate_m, prior->gate_rad);
+      if (!(before[i] < std::numeric_limits<double>::infinity())) return;
+    }
     if (q.restrict_to_graph && has_regions && !node_of(pose)) return;
     int misses = 0;
     const double c = std::cos(pose.yaw()), s = std::sin(pose.yaw());
@@ -235,29 +249,58 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
     screened[i] = evaluate(pose, {}, 0.3, 3 * kDeg, q.tilt_sigma_deg * kDeg, near, screen).cost;
     passed[i] = 1;
   });
-  std::vector<std::pair<double, Pose2>> scored;
+  struct Scored {
+    double cost;  // screening, this image
+    Pose2 pose;
+    double drive;  // with a prior: the drive's cost so far, this image's included
+  };
+  std::vector<Scored> scored;
   for (std::size_t i = 0; i < poses.size(); ++i)
-    if (passed[i]) scored.emplace_back(screened[i], poses[i].second);
+    if (passed[i]) scored.push_back({screened[i], poses[i].second, before[i]});
   out.merit_evaluations = static_cast<int>(scored.size());
   if (scored.empty()) {
-    out.why = "no place of the map has lamps where the " + std::to_string(ns) +
-              " lamps nearest the zenith are seen";
+    out.why = prior ? "no place the earlier images allowed has lamps where the " +
+                          std::to_string(ns) + " lamps nearest the zenith are seen"
+                    : "no place of the map has lamps where the " + std::to_string(ns) +
+                          " lamps nearest the zenith are seen";
     return out;
   }
   std::stable_sort(scored.begin(), scored.end(),
-                   [](const auto& a, const auto& b) { return a.first < b.first; });
+                   [](const Scored& a, const Scored& b) { return a.cost < b.cost; });
+  const double best = scored.front().cost;
+  if (prior) {
+    // The drive's evidence: a place's cost is its best carried predecessor's plus what this
+    // image says (capped: one odd image never decides alone), relative to the likeliest.
+    double least = std::numeric_limits<double>::infinity();
+    for (Scored& c : scored) {
+      c.drive += std::min(prior->view_cost_cap, c.cost - best);
+      least = std::min(least, c.drive);
+    }
+    for (Scored& c : scored) c.drive -= least;
+    scored.erase(std::remove_if(scored.begin(), scored.end(),
+                                [&](const Scored& c) { return c.drive > prior->cost_max; }),
+                 scored.end());
+  } else {
+    for (Scored& c : scored) c.drive = c.cost - best;
+  }
   // Refined: the screening scores within reach of the best (a coarse pose is up to a cell off,
   // and the screen sees only part of the view), at most four times the cap; then every refined
   // pose within `margin` of the best must fit under the cap for the search to be complete.
-  const double reach = scored.front().first + margin + 30.0;
+  const double reach = best + margin + 30.0;
   const std::size_t limit = 4 * std::size_t(cap);
   std::size_t in_reach = 0;
-  while (in_reach < scored.size() && !(scored[in_reach].first > reach)) ++in_reach;
+  while (in_reach < scored.size() && !(scored[in_reach].cost > reach)) ++in_reach;
+  out.candidates.reserve(in_reach);
+  out.candidate_costs.reserve(in_reach);
+  for (std::size_t k = 0; k < in_reach; ++k) {
+    out.candidates.push_back(scored[k].pose);
+    out.candidate_costs.push_back(scored[k].drive);
+  }
   const std::size_t within = std::min(in_reach, limit + 1);  // over the limit: incomplete
   // One level round each: enough to rank the candidates; the hypothesis set refines in full.
   std::vector<PoseHypothesis> refined(std::min(in_reach, limit));
   for_each_costly_index(refined.size(), serial_up_to(2), [&](std::size_t k) {
-    refined[k] = refine(scored[k].second, 0.3, 3 * kDeg, blobs, 1, false);
+    refined[k] = refine(scored[k].pose, 0.3, 3 * kDeg, blobs, 1, false);
   });
   drop_outside_graph(refined);
   // The plausible ones (within the ambiguity margin of the best, 32 at most) refined in full,
@@ -283,8 +326,8 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   out.complete = out.found() && within <= limit && kept <= std::size_t(cap);
   if (out.hypotheses.size() > std::size_t(cap)) out.hypotheses.resize(cap);
   if (!out.complete && out.found())
-    out.why = std::to_string(std::max(kept, within)) +
-              " places fit the lamps near the zenith, more than the " + std::to_string(cap) +
+    out.why = std::to_string(std::max(kept, in_reach)) + " poses fit the lamps near the zenith" +
+              (prior ? " and the drive so far" : "") + ", more than the " + std::to_string(cap) +
               " that can be followed: more images are needed";
   return out;
 }

@@ -108,10 +108,30 @@ struct GlobalLocalization {
   // Every place the votes point to was scored and every plausible hypothesis returned: the
   // true pose, if the image shows lamps of the map, is among the hypotheses.
   bool complete = false;
+  // enumerate(): every coarse pose (0.25 m x 3 degree cells) the image allows, within reach of
+  // the best before refinement, however many: the prior of the next image's enumeration.
+  std::vector<Pose2> candidates;
+  // One per candidate: with a prior, the drive's cost (-2 ln L: the prior's cost of the place it
+  // continues plus this image's, capped) relative to the likeliest place; without, this image's
+  // screening cost relative to the best.
+  std::vector<double> candidate_costs;
   std::string why;  // why there is no hypothesis, or why it is ambiguous
   int blobs = 0;    // detections used
+  int seeds = 0;    // enumerate(): blobs near the axis a pose was sought from (two needed)
   int merit_evaluations = 0;
   bool found() const { return !hypotheses.empty(); }
+};
+
+// The places earlier images allowed, carried to this image by odometry: an enumeration given
+// them keeps only the poses within the gate of one of them. While every single view of a regular
+// building fits thousands of places, their intersection along the drive does not.
+struct EnumerationPrior {
+  std::vector<Pose2> poses;
+  std::vector<double> costs;  // one per pose: the drive's cost of the place so far (-2 ln L)
+  double gate_m = 0.5;        // position
+  double gate_rad = 0.1;      // heading
+  double view_cost_cap = 12;  // what one image can add to a place's cost
+  double cost_max = 30;       // places costing more than the likeliest by this are dropped
 };
 
 class GlobalLocalizer {
@@ -132,9 +152,10 @@ class GlobalLocalizer {
   // the most voted cells: on a regular ceiling votes rank look-alikes above the truth), poses
   // outside the graph or with the other seeds off the lamps dropped, the rest scored, the
   // plausible refined. `complete` says whether every refined pose within `margin` (-2 ln L) of
-  // the best fits under `cap` (then they are all returned, best first).
-  GlobalLocalization enumerate(const vision::OmniDetection& detection, int cap,
-                               double margin) const;
+  // the best fits under `cap` (then they are all returned, best first). With a `prior`, only the
+  // poses within its gate are considered: complete then means every such pose was returned.
+  GlobalLocalization enumerate(const vision::OmniDetection& detection, int cap, double margin,
+                               const EnumerationPrior* prior = nullptr) const;
 
   // A pose scored against one image as the default method scores its candidates: -2 log
   // likelihood (matched directions, lamps in clear view not seen, blobs nothing explains), for a

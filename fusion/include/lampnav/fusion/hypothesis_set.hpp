@@ -42,6 +42,15 @@ struct HypothesisSetOptions {
   // While the set is incomplete, the next enumeration waits for this much travel (m) or turn
   // (deg): a view a metre on fits the same places, and enumerating costs up to 0.7 s.
   double enumerate_every_m = 2.0, enumerate_every_deg = 30.0;
+  // While the set is incomplete, the places each image allows are carried to the next
+  // enumeration, which keeps only the poses within this gate of one of them (growing with the
+  // travel as odometry's sigma does, three times over): the places the drive so far allows.
+  // Each place adds up what the images said of it (each capped at frame_cost_cap, an image
+  // that did not allow it at all costing the cap); one costing place_cost_max more than the
+  // likeliest is dropped.
+  bool carry_places = true;
+  double place_gate_m = 0.5, place_gate_deg = 8.0;
+  double place_cost_max = 30.0;
   double drop_ratio = 1e-9;               // hypotheses below this likelihood ratio to the best die
   double birth_ratio = 1e-4;              // an image gives birth to the places within this ratio of
                                           // its best (the truth's own noise stays far inside it)
@@ -132,7 +141,8 @@ class HypothesisSet {
 
   struct Counts {
     std::uint64_t born = 0, merged = 0, through_walls = 0, dropped = 0, resets = 0,
-                  enumerations = 0, complete_enumerations = 0;
+                  enumerations = 0, complete_enumerations = 0,
+                  place_restarts = 0;  // the places the drive allowed all lost: started again
   };
   const Counts& counts() const;
   const HypothesisSetOptions& options() const;
