@@ -168,7 +168,7 @@ void kidnaps_on(int nodes, int episodes) {
 }
 
 TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf10Nodes) { kidnaps_on(10, 10); }
-TEST(Hypotheses, DISABLED_KidnapsOnAGeneratedBuildingOf1000Nodes) { kidnaps_on(1000, 10); }
+TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf1000Nodes) { kidnaps_on(1000, 10); }
 TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf100Nodes) { kidnaps_on(100, 10); }
 
 TEST(Hypotheses, UnknownStartsOnAGeneratedBuildingOf100Nodes) {
