@@ -43,6 +43,8 @@ void GlobalLocalizerOptions::validate() const {
   check(p.noise_xy_m >= 0 && p.noise_yaw_deg >= 0, "paper.noise", "must not be negative");
   check(p.threshold_px > 0, "paper.threshold_px", "must be positive");
   const LampPairOptions& q = pairs;
+  check(q.seed_centroid_shift >= 0 && q.seed_centroid_shift <= 1, "pairs.seed_centroid_shift",
+        "must be between 0 and 1");
   check(q.pair_max_theta_deg > 0 && q.pair_max_theta_deg < 90, "pairs.pair_max_theta_deg",
         "must be between 0 and 90");
   check(q.pair_max_blobs >= 2 && q.pair_max_blobs <= 64, "pairs.pair_max_blobs", "must be 2 to 64");

@@ -220,8 +220,10 @@ struct GlobalLocalizer::Impl {
     std::vector<double> sigma;
     std::size_t size() const { return rays.size(); }
   };
-  Seeds seeds_of(const std::vector<BlobRay>& blobs, const LampPairOptions& q,
-                 std::size_t max) const;
+  // `oblique`: a seed's sigma allows for a long lamp's centroid off its centre (the
+  // enumeration), or the vote's tuned tenth of the lamp's length.
+  Seeds seeds_of(const std::vector<BlobRay>& blobs, const LampPairOptions& q, std::size_t max,
+                 bool oblique) const;
   // Each pose that puts seeds j and k on a pair of map lamps spaced like them (both classes'
   // index looked up by spacing): fn(pose).
   template <class Fn>

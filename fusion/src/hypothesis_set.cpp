@@ -50,6 +50,8 @@ void HypothesisSetOptions::validate() const {
   check(max_hypotheses >= 1 && max_hypotheses <= 100000, "max_hypotheses", "must be 1 to 100000");
   check(place_gate_m > 0 && place_gate_deg > 0, "place_gate_m", "must be positive");
   check(place_cost_max >= frame_cost_cap, "place_cost_max", "must be at least frame_cost_cap");
+  check(place_allowance >= 0 && place_allowance < frame_cost_cap, "place_allowance",
+        "must be in [0, frame_cost_cap)");
   check(drop_ratio > 0 && drop_ratio < 1e-3, "drop_ratio", "must be in (0, 0.001)");
   check(birth_ratio >= drop_ratio && birth_ratio < 1, "birth_ratio", "must be in [drop_ratio, 1)");
   check(symmetry_check_max >= 2, "symmetry_check_max", "must be at least 2");
@@ -392,6 +394,7 @@ struct HypothesisSet::Impl {
     prior.gate_rad = (o.place_gate_deg + 3 * o.sigma_yaw_deg_per_m * travel) * kDeg;
     prior.view_cost_cap = o.frame_cost_cap;
     prior.cost_max = o.place_cost_max;
+    prior.view_allowance = o.place_allowance;
     return prior;
   }
 
@@ -402,17 +405,23 @@ struct HypothesisSet::Impl {
     std::vector<Place> next, missed;
     const Pose2 at = odo.at(stamp);
     for (std::size_t k = 0; k < r.candidates.size(); ++k)
-      next.push_back(
-          {r.candidates[k], stamp, at, 0.0,
-           prior ? r.candidate_costs[k] : std::min(o.frame_cost_cap, r.candidate_costs[k])});
+      next.push_back({r.candidates[k], stamp, at, 0.0,
+                      prior ? r.candidate_costs[k]
+                            : std::max(0.0, std::min(o.frame_cost_cap, r.candidate_costs[k]) -
+                                                o.place_allowance)});
     if (prior) {
       const detail::PoseGrid allowed(r.candidates, prior->gate_m);
+      // An image with two lamps near the zenith may miss the true place (one of them off its
+      // lamp): it says nothing of the places it did not allow.
+      const bool says = r.seeds >= 3;
       for (Place p : places) {
         if (allowed.near(p.pose, prior->gate_m, prior->gate_rad)) continue;
-        p.cost += o.frame_cost_cap;
-        if (p.cost > o.place_cost_max) continue;
+        if (says) {
+          p.cost += o.frame_cost_cap - o.place_allowance;
+          if (p.cost > o.place_cost_max) continue;
+          missed.push_back(p);
+        }
         next.push_back(p);
-        missed.push_back(p);
       }
     }
     places = std::move(next);

@@ -367,12 +367,18 @@ TEST(GlobalLocalizer, AnEnumerationKeepsToThePlacesItsPriorAllows) {
   const GlobalLocalizer global(map, m.cam());
   std::mt19937_64 rng(41);
   std::uniform_real_distribution<double> u(0, 1);
-  auto near_truth = [](const Pose2& p, const Pose2& truth) {
-    return (p.translation() - truth.translation()).norm() < 0.3 &&
-           std::abs(wrap_angle(p.yaw() - truth.yaw())) < 3 * M_PI / 180;
+  // A refined pose is near the truth within 0.3 m and 3 degrees; a candidate, coarse (a seed
+  // pair's pose, off by up to 0.4 m and 6 degrees), within 0.5 m and 8.
+  auto near = [](const Pose2& p, const Pose2& truth, double metres, double deg) {
+    return (p.translation() - truth.translation()).norm() < metres &&
+           std::abs(wrap_angle(p.yaw() - truth.yaw())) < deg * M_PI / 180;
+  };
+  auto near_truth = [&](const Pose2& p, const Pose2& truth) { return near(p, truth, 0.3, 3); };
+  auto coarse_near_truth = [&](const Pose2& p, const Pose2& truth) {
+    return near(p, truth, 0.5, 8);
   };
   int crowded = 0, unfound = 0;
-  const int views = 8;
+  const int views = 16;
   for (int view = 0; view < views; ++view) {
     const graph::Node& c = *corridors[rng() % corridors.size()];
     const Pose2 truth(c.axis->point_at((0.3 + 0.4 * u(rng)) * c.axis->length()), 2 * M_PI * u(rng));
@@ -381,18 +387,22 @@ TEST(GlobalLocalizer, AnEnumerationKeepsToThePlacesItsPriorAllows) {
     ASSERT_TRUE(alone.found()) << alone.why;
     ASSERT_EQ(alone.candidates.size(), alone.candidate_costs.size());
     bool truth_there = false;
-    for (const Pose2& p : alone.candidates) truth_there = truth_there || near_truth(p, truth);
+    for (const Pose2& p : alone.candidates)
+      truth_there = truth_there || coarse_near_truth(p, truth);
     if (!truth_there) {
-      // Merged or cut blobs among the seeds put them off their lamps (docs/hypotheses.md, "What
-      // is not done"): the prior cannot bring back what the image's search did not find.
+      // With two seeds, one off its lamp (a long lamp seen obliquely, or merged with another)
+      // hides the true place: such a search never says it is complete. With three or more, a
+      // minority of them may be off and the truth is still found.
+      EXPECT_LT(alone.seeds, 3) << "view " << view << ": the truth is not among the candidates";
+      EXPECT_FALSE(alone.complete) << "view " << view;
       ++unfound;
       continue;
     }
     if (alone.candidates.size() > 512) ++crowded;
 
     EnumerationPrior prior;
-    prior.gate_m = 0.5;
-    prior.gate_rad = 8 * M_PI / 180;
+    prior.gate_m = 1.0;
+    prior.gate_rad = 12 * M_PI / 180;
     prior.poses = {truth * Pose2(0.2, -0.1, 0.04)};
     prior.costs = {3.0};
     // Places the prior allows elsewhere: the best of the view's own that are far from the truth.
@@ -403,9 +413,12 @@ TEST(GlobalLocalizer, AnEnumerationKeepsToThePlacesItsPriorAllows) {
       }
     const GlobalLocalization r = global.enumerate(d, 512, 18.4, &prior);
     ASSERT_TRUE(r.found()) << r.why;
-    EXPECT_TRUE(r.complete) << "view " << view << ": " << r.why;
+    // Two seeds cannot vouch for the search (one may be off its lamp); three can.
+    EXPECT_EQ(r.complete, r.seeds >= 3) << "view " << view << ": " << r.why;
     bool found = false;
-    for (const auto& h : r.hypotheses) found = found || near_truth(h.pose, truth);
+    // The place (its least squares may settle a few degrees off from a coarse start; the
+    // hypothesis set's frames refine it on).
+    for (const auto& h : r.hypotheses) found = found || near(h.pose, truth, 0.3, 6);
     EXPECT_TRUE(found) << "view " << view << ": the truth is not returned";
     double least = 1e9;
     for (std::size_t k = 0; k < r.candidates.size(); ++k) {

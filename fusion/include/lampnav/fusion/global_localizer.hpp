@@ -59,11 +59,15 @@ struct LampPairOptions {
   double max_theta_deg = 88.0;       // lamps and blobs used to score a pose
   double expect_max_theta_deg = 80.0;  // a lamp further off-axis may be missed without cost
   double detection_sigma_deg = 0.1;    // a blob's direction
-  double tilt_sigma_deg = 0.6;         // floor bumps swing the camera
-  double miss_cost = 4.6;              // -2 ln 0.1: a lamp in clear view that is not seen
-  double spurious_cost = 6.0;          // a blob no lamp explains
-  double ambiguity_margin = 9.2;       // hypotheses within this of the best (2 ln 100) remain
-  double distinct_m = 0.75;            // hypotheses closer than this (and distinct_deg) are one
+  // In enumerate(), a seed's lamp may be off where its blob's centroid puts it by this
+  // fraction of the lamp's length times the sine of its angle off the zenith (a long lamp seen
+  // obliquely).
+  double seed_centroid_shift = 0.25;
+  double tilt_sigma_deg = 0.6;    // floor bumps swing the camera
+  double miss_cost = 4.6;         // -2 ln 0.1: a lamp in clear view that is not seen
+  double spurious_cost = 6.0;     // a blob no lamp explains
+  double ambiguity_margin = 9.2;  // hypotheses within this of the best (2 ln 100) remain
+  double distinct_m = 0.75;       // hypotheses closer than this (and distinct_deg) are one
   double distinct_deg = 10.0;
   int candidates = 48;            // hypotheses scored after voting
   int refined = 12;               // of those, refined by least squares
@@ -131,7 +135,10 @@ struct EnumerationPrior {
   double gate_m = 0.5;        // position
   double gate_rad = 0.1;      // heading
   double view_cost_cap = 12;  // what one image can add to a place's cost
-  double cost_max = 30;       // places costing more than the likeliest by this are dropped
+  // What one image may cost a place without counting (a lamp hidden or merged, a coarse
+  // pose): each image's cost less this, a place's cost never below 0.
+  double view_allowance = 0.0;
+  double cost_max = 30;  // places costing more than the likeliest by this are dropped
 };
 
 class GlobalLocalizer {
