@@ -13,6 +13,9 @@
 
 #include <benchmark/benchmark.h>
 
+#include <cstdlib>
+#include <iostream>
+
 #include <string>
 
 #include "battery.hpp"
@@ -64,7 +67,21 @@ void run_battery(benchmark::State& state, std::uint64_t first_seed, Episode epis
   for (auto _ : state) {
     test::Battery battery(w.map, w.robot, {}, localizer);
     std::vector<test::EpisodeResult> rs;
-    for (int k = 1; k <= state.range(1); ++k) rs.push_back(episode(battery, first_seed + k));
+    // LAMPNAV_EPISODE=seed runs that episode alone; LAMPNAV_EPISODES=1 prints each (stderr).
+    const char* only = std::getenv("LAMPNAV_EPISODE");
+    for (int k = 1; k <= state.range(1); ++k) {
+      const std::uint64_t seed = first_seed + k;
+      if (only && std::strtoull(only, nullptr, 10) != seed) continue;
+      rs.push_back(episode(battery, seed));
+      if (only || std::getenv("LAMPNAV_EPISODES")) {
+        const test::EpisodeResult& r = rs.back();
+        std::cerr << "seed " << seed << ": detected " << r.detected << ", fixed " << r.fixed
+                  << ", right " << r.fix_correct << ", wrong fixes " << r.wrong_fixes << ", after "
+                  << r.latency_m << " m (oracle "
+                  << (r.oracle_m ? std::to_string(*r.oracle_m) + " m" : "undecided") << ")"
+                  << (r.fixed ? "" : ": " + r.last_why) << "\n";
+      }
+    }
     f = test::figures(rs);
   }
   report(state, f);

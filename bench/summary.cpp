@@ -371,13 +371,13 @@ int main(int argc, char** argv) {
     add_count(std::string("node: messages lost (") + format + ", 30 Hz images, 150 Hz odometry)",
               counter(bench, "lost", 1), 0);
   }
-  for (const auto& [n, count] : {std::pair{"10", "100"}, {"100", "100"}, {"1000", "10"}})
+  for (const auto& [n, count] : {std::pair{"10", "100"}, {"100", "100"}, {"1000", "100"}})
     add_battery(std::string("kidnaps (") + count + "), " + n + "-node building",
                 std::string("BM_KidnapBattery/") + n + "/" + count, true);
   add("  the same 100-node kidnaps, hypotheses weighed on one core: per frame with 50 to 200",
       counter("BM_KidnapBatteryOneCore/100/100", "us_per_frame_50_200_hypotheses", 1), "",
       std::nullopt, std::nullopt, std::nullopt);
-  for (const auto& [n, count] : {std::pair{"10", "20"}, {"100", "20"}, {"1000", "3"}})
+  for (const auto& [n, count] : {std::pair{"10", "20"}, {"100", "20"}, {"1000", "20"}})
     add_battery(std::string("unknown starts (") + count + "), " + n + "-node building",
                 std::string("BM_UnknownStartBattery/") + n + "/" + count, false);
 
