@@ -445,8 +445,9 @@ struct HypothesisSet::Impl {
     if (o.carry_places && (r.found() || r.seeds >= 2)) {
       missed = update_places(r, with_prior ? &prior : nullptr, stamp, odo);
       if (with_prior && places.empty()) {
-        // No place the drive allowed fits this image twice running: the places were lost (or
-        // the robot carried away); start again from this image alone.
+        // Every place the drive allowed is gone (this image allowed none of them, and what it
+        // cost them dropped the rest): the places were lost, or the robot carried away again.
+        // Start again from this image alone.
         ++counts.place_restarts;
         r = omni->enumerate(d, o.max_hypotheses, margin);
         missed = update_places(r, nullptr, stamp, odo);
@@ -460,8 +461,9 @@ struct HypothesisSet::Impl {
     const double best_score = r.hypotheses.front().score;
     std::size_t n = 0;
     while (n < r.hypotheses.size() && r.hypotheses[n].score <= best_score + margin) ++n;
-    // A place of the drive this image alone did not allow still counts until a second image
-    // agrees: one odd image (a lamp hidden) never removes the truth. Then it is a hypothesis.
+    // A place of the drive this image did not allow still counts while its cost stays within
+    // place_cost_max (one odd image, a lamp hidden, never removes the truth): it is born too,
+    // at its cost, and the frames that follow weigh it like the others.
     if (r.complete && n + missed.size() <= std::size_t(o.max_hypotheses)) {
       ++counts.complete_enumerations;
       std::vector<Hypothesis> next;
