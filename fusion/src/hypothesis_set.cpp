@@ -92,12 +92,11 @@ struct HypothesisSet::Impl {
   // allowed it put it (carry_places).
   struct Place {
     Pose2 pose;
-    Stamp stamp;
-    Pose2 odometry;     // dead-reckoned at stamp
     double travel = 0;  // since an image last allowed it (m)
     double cost = 0;    // -2 ln L of the drive so far, relative to the likeliest place
   };
   std::vector<Place> places;
+  std::pair<Stamp, Pose2> places_at;  // the capture every place stands at, dead-reckoned pose
   mutable std::map<std::pair<int, int>, bool> twin_cache;  // by hypothesis ids
 
   // Whether the rigid motion taking pose a to pose b maps every lamp of the map onto a lamp of
@@ -377,12 +376,13 @@ struct HypothesisSet::Impl {
     EnumerationPrior prior;
     std::vector<Place> kept;
     double travel = 0;
+    const Pose2 at = odo.at(stamp);
+    const Pose2 moved = places_at.second.between(at);
+    const double step = places.empty() ? 0.0 : odo.travel(places_at.first, stamp);
+    places_at = {stamp, at};
     for (Place p : places) {
-      p.travel += odo.travel(p.stamp, stamp);
-      const Pose2 at = odo.at(stamp);
-      p.pose = p.pose * p.odometry.between(at);
-      p.odometry = at;
-      p.stamp = stamp;
+      p.travel += step;
+      p.pose = p.pose * moved;
       if (!inside(p.pose)) continue;
       travel = std::max(travel, p.travel);
       prior.poses.push_back(p.pose);
@@ -403,9 +403,9 @@ struct HypothesisSet::Impl {
   std::vector<Place> update_places(const GlobalLocalization& r, const EnumerationPrior* prior,
                                    Stamp stamp, const OdometryTrack& odo) {
     std::vector<Place> next, missed;
-    const Pose2 at = odo.at(stamp);
+    places_at = {stamp, odo.at(stamp)};  // the carried ones stand there already
     for (std::size_t k = 0; k < r.candidates.size(); ++k)
-      next.push_back({r.candidates[k], stamp, at, 0.0,
+      next.push_back({r.candidates[k], 0.0,
                       prior ? r.candidate_costs[k]
                             : std::max(0.0, std::min(o.frame_cost_cap, r.candidate_costs[k]) -
                                                 o.place_allowance)});

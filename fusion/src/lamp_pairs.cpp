@@ -9,6 +9,7 @@
 #include <unordered_map>
 
 #include "global_localizer_impl.hpp"
+#include "lampnav/core/error.hpp"
 #include "lampnav/core/parallel.hpp"
 #include "pose_grid.hpp"
 #include "spurious_blobs.hpp"
@@ -217,11 +218,14 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   for (const BlobRay& b : blobs)
     if (b.theta <= screen) near.push_back(b);
   // Near a place an earlier image allowed, in the graph, and the other seeds on lamps (all but
-  // one of them).
+  // a minority of them, below).
   std::optional<PoseGrid> allowed;
-  if (prior)
-    allowed.emplace(prior->poses, prior->gate_m,
-                    prior->costs.size() == prior->poses.size() ? &prior->costs : nullptr);
+  if (prior) {
+    if (!prior->costs.empty() && prior->costs.size() != prior->poses.size())
+      throw Error("enumerate: the prior has " + std::to_string(prior->costs.size()) +
+                  " costs for " + std::to_string(prior->poses.size()) + " poses");
+    allowed.emplace(prior->poses, prior->gate_m, prior->costs.empty() ? nullptr : &prior->costs);
+  }
   std::vector<std::pair<std::int64_t, Pose2>> poses(cells.begin(), cells.end());
   std::sort(poses.begin(), poses.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });

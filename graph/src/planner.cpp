@@ -4,8 +4,8 @@
 #include <boost/graph/dijkstra_shortest_paths.hpp>
 #include <cstdio>
 
-#include "lampnav/graph/corridor_geometry.hpp"
 #include "lampnav/core/error.hpp"
+#include "lampnav/graph/corridor_geometry.hpp"
 #include "map_impl.hpp"
 
 namespace lampnav::graph {

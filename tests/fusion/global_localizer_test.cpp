@@ -432,6 +432,11 @@ TEST(GlobalLocalizer, AnEnumerationKeepsToThePlacesItsPriorAllows) {
     }
     EXPECT_EQ(least, 0.0) << "view " << view;
 
+    // Costs, when given, are one per pose.
+    EnumerationPrior uneven = prior;
+    uneven.costs.push_back(0.0);
+    EXPECT_THROW(global.enumerate(d, 512, 18.4, &uneven), Error);
+
     // Without the truth in the prior, nothing near it comes back.
     prior.poses.erase(prior.poses.begin());
     prior.costs.erase(prior.costs.begin());

@@ -131,7 +131,7 @@ struct GlobalLocalization {
 // building fits thousands of places, their intersection along the drive does not.
 struct EnumerationPrior {
   std::vector<Pose2> poses;
-  std::vector<double> costs;  // one per pose: the drive's cost of the place so far (-2 ln L)
+  std::vector<double> costs;  // one per pose (or none: all 0): the drive's cost so far (-2 ln L)
   double gate_m = 0.5;        // position
   double gate_rad = 0.1;      // heading
   double view_cost_cap = 12;  // what one image can add to a place's cost
@@ -160,7 +160,8 @@ class GlobalLocalizer {
   // outside the graph or with the other seeds off the lamps dropped, the rest scored, the
   // plausible refined. `complete` says whether every refined pose within `margin` (-2 ln L) of
   // the best fits under `cap` (then they are all returned, best first). With a `prior`, only the
-  // poses within its gate are considered: complete then means every such pose was returned.
+  // poses within its gate are considered: complete then means every such pose was returned
+  // (throws Error when the prior has costs, but not one per pose).
   GlobalLocalization enumerate(const vision::OmniDetection& detection, int cap, double margin,
                                const EnumerationPrior* prior = nullptr) const;
 
