@@ -58,6 +58,38 @@ void report(benchmark::State& state, const test::BatteryFigures& f) {
   state.counters["past_oracle_m_p95"] = f.past_oracle_m_p95;
 }
 
+// LAMPNAV_TRACE=1 (with LAMPNAV_EPISODE): after each frame that changed the number of
+// hypotheses (or every 5 s), the time, the verdict, the hypotheses, and the truth's rank and
+// weight among them; LAMPNAV_TRACE=2 adds the truth and the six likeliest (stderr).
+void trace_frame(double t, const Pose2& truth, const fusion::Localizer& loc) {
+  const fusion::HypothesisSet& set = loc.hypotheses();
+  const auto& hs = set.hypotheses();
+  static std::size_t last_count = 0;
+  static double last_t = -1;
+  if (hs.size() == last_count && t - last_t < 5) return;
+  last_count = hs.size();
+  last_t = t;
+  int rank = -1;
+  for (std::size_t k = 0; k < hs.size() && rank < 0; ++k)
+    if ((hs[k].pose.translation() - truth.translation()).norm() < 0.5 &&
+        std::abs(wrap_angle(hs[k].pose.yaw() - truth.yaw())) < 5 * M_PI / 180)
+      rank = static_cast<int>(k);
+  std::cerr << "t " << t << " " << fusion::to_string(set.verdict()) << " hypotheses " << hs.size()
+            << " truth rank " << rank;
+  if (rank >= 0) std::cerr << " weight " << hs[rank].weight;
+  if (!hs.empty()) std::cerr << " best " << hs.front().weight;
+  if (hs.size() > 1) std::cerr << " second " << hs[1].weight;
+  std::cerr << "\n";
+  if (std::string(std::getenv("LAMPNAV_TRACE")) == "2") {
+    std::cerr << "  truth " << truth << "\n";
+    for (std::size_t k = 0; k < std::min<std::size_t>(hs.size(), 6); ++k)
+      std::cerr << "  " << hs[k].pose << " w " << hs[k].weight << " last " << hs[k].last_cost
+                << "\n";
+    if (rank >= 6)
+      std::cerr << "  truth's " << hs[rank].pose << " last " << hs[rank].last_cost << "\n";
+  }
+}
+
 // range(0) nodes, range(1) episodes, each `episode(battery, seed)`.
 template <class Episode>
 void run_battery(benchmark::State& state, std::uint64_t first_seed, Episode episode,
@@ -65,7 +97,9 @@ void run_battery(benchmark::State& state, std::uint64_t first_seed, Episode epis
   const World w(static_cast<int>(state.range(0)));
   test::BatteryFigures f;
   for (auto _ : state) {
-    test::Battery battery(w.map, w.robot, {}, localizer);
+    test::BatteryOptions options;
+    if (std::getenv("LAMPNAV_TRACE")) options.trace = trace_frame;
+    test::Battery battery(w.map, w.robot, options, localizer);
     std::vector<test::EpisodeResult> rs;
     // LAMPNAV_EPISODE=seed runs that episode alone; LAMPNAV_EPISODES=1 prints each (stderr).
     const char* only = std::getenv("LAMPNAV_EPISODE");

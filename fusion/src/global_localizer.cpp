@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "global_localizer_impl.hpp"
@@ -48,6 +49,8 @@ void GlobalLocalizerOptions::validate() const {
   check(q.pair_max_theta_deg > 0 && q.pair_max_theta_deg < 90, "pairs.pair_max_theta_deg",
         "must be between 0 and 90");
   check(q.pair_max_blobs >= 2 && q.pair_max_blobs <= 64, "pairs.pair_max_blobs", "must be 2 to 64");
+  check(q.screen_max_theta_deg > 0 && q.screen_max_theta_deg < 90, "pairs.screen_max_theta_deg",
+        "must be between 0 and 90");
   check(q.max_theta_deg > 0 && q.max_theta_deg <= 180, "pairs.max_theta_deg",
         "must be between 0 and 180");
   check(q.expect_max_theta_deg > 0 && q.expect_max_theta_deg <= q.max_theta_deg,
@@ -384,7 +387,6 @@ GlobalLocalizer::Impl::Solution GlobalLocalizer::Impl::solve(Pose2 pose, Tilt ti
   const double det = o.pairs.detection_sigma_deg * kDeg;
   const double tilt_prior =
       with_tilt ? 1.0 / std::pow(std::max(1e-6, o.pairs.tilt_sigma_deg * kDeg), 2) : 1e16;
-  if (!with_tilt) tilt = Tilt{};
   Matrix5d JtJ = Matrix5d::Identity();
   double cost = 0;
   for (int iter = 0; iter < 8; ++iter) {
@@ -429,8 +431,10 @@ GlobalLocalizer::Impl::Solution GlobalLocalizer::Impl::solve(Pose2 pose, Tilt ti
     if (with_tilt) cost += tilt_prior * (tilt.roll * tilt.roll + tilt.pitch * tilt.pitch);
     JtJ(3, 3) += tilt_prior;
     JtJ(4, 4) += tilt_prior;
-    Jtr(3) -= tilt_prior * tilt.roll;
-    Jtr(4) -= tilt_prior * tilt.pitch;
+    if (with_tilt) {  // the prior pulls toward a level floor; else the tilt is held as given
+      Jtr(3) -= tilt_prior * tilt.roll;
+      Jtr(4) -= tilt_prior * tilt.pitch;
+    }
     const Vector5d step = (JtJ + 1e-12 * Matrix5d::Identity()).ldlt().solve(Jtr);
     if (!step.allFinite()) break;
     pose = Pose2(pose.x() + step(0), pose.y() + step(1), wrap_angle(pose.yaw() + step(2)));
@@ -444,9 +448,10 @@ GlobalLocalizer::Impl::Solution GlobalLocalizer::Impl::solve(Pose2 pose, Tilt ti
 
 PoseHypothesis GlobalLocalizer::Impl::refine(Pose2 pose, double position_sigma, double yaw_sigma,
                                              const std::vector<BlobRay>& blobs, int rounds,
-                                             bool with_tilt) const {
+                                             bool with_tilt, const Tilt& held,
+                                             Tilt* tilt_out) const {
   const double tilt_sigma = o.pairs.tilt_sigma_deg * kDeg;
-  Tilt tilt;
+  Tilt tilt = held;
   Evaluation e = evaluate(pose, tilt, position_sigma, yaw_sigma, tilt_sigma, blobs);
   Matrix3d cov = Vector3d(position_sigma * position_sigma, position_sigma * position_sigma,
                           yaw_sigma * yaw_sigma)
@@ -455,7 +460,7 @@ PoseHypothesis GlobalLocalizer::Impl::refine(Pose2 pose, double position_sigma, 
   for (int round = 0; round < rounds && e.matches.size() >= 2; ++round) {
     // The tilt is estimated only when it explains the directions clearly better (by more
     // than chi-square's 95 % point for its two degrees of freedom) than a level floor.
-    const Solution level = solve(pose, tilt, e, blobs, false);
+    const Solution level = solve(pose, held, e, blobs, false);
     const Solution tilted = with_tilt && tilt_sigma > 0 ? solve(pose, tilt, e, blobs, true) : level;
     const Solution& sol = tilted.cost + 6.0 < level.cost ? tilted : level;
     pose = sol.pose;
@@ -484,6 +489,7 @@ PoseHypothesis GlobalLocalizer::Impl::refine(Pose2 pose, double position_sigma, 
   }
   std::sort(h.matches.begin(), h.matches.end(),
             [](const LampMatch& a, const LampMatch& b) { return a.blob < b.blob; });
+  if (tilt_out) *tilt_out = tilt;
   return h;
 }
 
@@ -501,7 +507,7 @@ MeritFunction GlobalLocalizer::Impl::merit_function(const vision::OmniDetection&
 
 void GlobalLocalizer::Impl::finish(GlobalLocalization& out, std::vector<PoseHypothesis> hs,
                                    const vision::OmniDetection& d, const LampPairOptions& q,
-                                   int max_hypotheses) const {
+                                   int max_hypotheses, bool with_merit) const {
   std::stable_sort(hs.begin(), hs.end(), [](const PoseHypothesis& a, const PoseHypothesis& b) {
     return a.score < b.score;
   });
@@ -518,7 +524,8 @@ void GlobalLocalizer::Impl::finish(GlobalLocalization& out, std::vector<PoseHypo
     out.why = "no pose explains any of the " + std::to_string(out.blobs) + " lamps seen";
     return;
   }
-  const MeritFunction merit = merit_function(d);
+  const std::optional<MeritFunction> merit =
+      with_merit ? std::optional<MeritFunction>(merit_function(d)) : std::nullopt;
   double total = 0;
   int plausible = 0;
   for (auto& h : kept) {
@@ -526,7 +533,7 @@ void GlobalLocalizer::Impl::finish(GlobalLocalization& out, std::vector<PoseHypo
     total += h.weight;
     if (h.score <= kept.front().score + q.ambiguity_margin) ++plausible;
     h.node = node_of(h.pose);
-    h.merit = paper_merit(h.pose, merit);
+    h.merit = merit ? paper_merit(h.pose, *merit) : std::numeric_limits<double>::quiet_NaN();
   }
   for (auto& h : kept) h.weight /= total;
   out.hypotheses = std::move(kept);

@@ -193,16 +193,18 @@ struct GlobalLocalizer::Impl {
   // predicted directions are nearest the seen ones. Tilt and translation both move the lamps in
   // view, but differently: a tilt turns every ray by the same angle, a translation turns a ray
   // by less the further off-axis its lamp is; the wide view tells them apart.
-  // Without `with_tilt` the floor is taken as level.
+  // Without `with_tilt` the tilt is held as given (zero: a level floor).
   Solution solve(Pose2 pose, Tilt tilt, const Evaluation& e, const std::vector<BlobRay>& blobs,
                  bool with_tilt) const;
 
   // Refines a pose: match, solve, match again with the tolerance the solution earned.
-  // `rounds` of match-and-solve; `with_tilt`: the floor's tilt considered (a level floor is
-  // three times cheaper, enough to tell a candidate from the rest).
+  // `rounds` of match-and-solve; `with_tilt`: the floor's tilt estimated too (three times
+  // dearer); else the tilt is held at `held` (a level floor, or the image's tilt estimated at
+  // another pose: a floor bump tilts the camera alike whatever the pose). `tilt_out`: the
+  // tilt of the result.
   PoseHypothesis refine(Pose2 pose, double position_sigma, double yaw_sigma,
-                        const std::vector<BlobRay>& blobs, int rounds = 3,
-                        bool with_tilt = true) const;
+                        const std::vector<BlobRay>& blobs, int rounds = 3, bool with_tilt = true,
+                        const Tilt& held = {}, Tilt* tilt_out = nullptr) const;
 
   // The paper's merit of a pose, for every hypothesis whatever its method.
   double paper_merit(const Pose2& pose, const MeritFunction& merit) const;
@@ -237,8 +239,11 @@ struct GlobalLocalizer::Impl {
                                 const EnumerationPrior* prior) const;
 
   // Ranks, merges near-duplicates, weighs, places on the graph, and says whether it is ambiguous.
+  // `with_merit`: each hypothesis gets the paper's merit too (a projection of the map's lamps
+  // per hypothesis); without, merit is NaN.
   void finish(GlobalLocalization& out, std::vector<PoseHypothesis> hs,
-              const vision::OmniDetection& d, const LampPairOptions& q, int max_hypotheses) const;
+              const vision::OmniDetection& d, const LampPairOptions& q, int max_hypotheses,
+              bool with_merit) const;
 
   // ---------------------------------------------------------------------------------------
   // Method `paper` (Alg. 3).

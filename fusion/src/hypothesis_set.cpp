@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 
@@ -429,15 +430,17 @@ struct HypothesisSet::Impl {
   }
 
   // Births from one image's enumeration. A complete one starts the set again from every place
-  // it found, weighed by the image (the kept estimate, if still alive, keeps its prior share and
-  // what this image said of it, capped); an incomplete one shows the places found, weighed by
-  // this image alone, beside the kept estimate (omni() removed the previous image's). While
-  // incomplete, each enumeration considers only the places the images before it allowed.
+  // it found, weighed by the image and by what the drive said of the place before it (the kept
+  // estimate, if still alive, keeps its prior share and what this image said of it, capped); an
+  // incomplete one shows the places found, weighed alike, beside the kept estimate (omni()
+  // removed the previous image's). While incomplete, each enumeration considers only the places
+  // the images before it allowed.
   void births(Stamp stamp, const vision::OmniDetection& d, const OdometryTrack& odo) {
     last_enumeration = {stamp, odo.at(stamp)};
     ++counts.enumerations;
     const double margin = -2 * std::log(o.birth_ratio);
     const EnumerationPrior prior = o.carry_places ? carry_places(stamp, odo) : EnumerationPrior{};
+    const std::uint64_t restarts_before = counts.place_restarts;
     const bool with_prior = !prior.poses.empty();
     GlobalLocalization r =
         omni->enumerate(d, o.max_hypotheses, margin, with_prior ? &prior : nullptr);
@@ -461,6 +464,20 @@ struct HypothesisSet::Impl {
     const double best_score = r.hypotheses.front().score;
     std::size_t n = 0;
     while (n < r.hypotheses.size() && r.hypotheses[n].score <= best_score + margin) ++n;
+    // What the drive said before this image: each hypothesis is born with the cost of the
+    // carried place it continues (the least within the gate), so that the places the drive has
+    // told apart from the truth are born behind it, not level with it.
+    const bool r_with_prior = with_prior && counts.place_restarts == restarts_before;
+    std::optional<detail::PoseGrid> drive;
+    if (r_with_prior) drive.emplace(prior.poses, prior.gate_m, &prior.costs);
+    const auto drive_cost = [&](const Pose2& p) {
+      if (!drive) return 0.0;
+      const double c = drive->least(p, prior.gate_m, prior.gate_rad);
+      return c < o.place_cost_max ? c : o.place_cost_max;
+    };
+    const auto cost_of = [&](const PoseHypothesis& h) {
+      return h.score - best_score + drive_cost(h.pose);
+    };
     // A place of the drive this image did not allow still counts while its cost stays within
     // place_cost_max (one odd image, a lamp hidden, never removes the truth): it is born too,
     // at its cost, and the frames that follow weigh it like the others.
@@ -478,8 +495,7 @@ struct HypothesisSet::Impl {
       const double each = std::log((1 - kept_share) /
                                    double(std::max<std::size_t>(1, r.plausible + missed.size())));
       for (std::size_t k = 0; k < n; ++k)
-        next.push_back(
-            born(r.hypotheses[k], stamp, odo, each - 0.5 * (r.hypotheses[k].score - best_score)));
+        next.push_back(born(r.hypotheses[k], stamp, odo, each - 0.5 * cost_of(r.hypotheses[k])));
       for (const Place& p : missed) {
         PoseHypothesis coarse;
         coarse.pose = p.pose;
@@ -500,7 +516,7 @@ struct HypothesisSet::Impl {
     }
     last_why = r.why.empty() ? "the image fits more places than were enumerated" : r.why;
     for (std::size_t k = 0; k < n; ++k)
-      hs.push_back(born(r.hypotheses[k], stamp, odo, -0.5 * (r.hypotheses[k].score - best_score)));
+      hs.push_back(born(r.hypotheses[k], stamp, odo, -0.5 * cost_of(r.hypotheses[k])));
   }
 
   // Whether an incomplete set should enumerate this image: the first after a loss, then once the

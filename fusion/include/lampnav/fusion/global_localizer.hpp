@@ -56,7 +56,13 @@ struct PaperMethodOptions {
 struct LampPairOptions {
   double pair_max_theta_deg = 75.0;  // detections used to form pairs (further off-axis: imprecise)
   int pair_max_blobs = 12;           // at most this many, nearest the optical axis first
-  double max_theta_deg = 88.0;       // lamps and blobs used to score a pose
+  // enumerate() screens every candidate pose on the lamps and blobs within this angle of the
+  // axis: the cone in which the omni camera places a lamp well (on the robots of maps/robots,
+  // within 0.15 m up to about 80 degrees). Narrower, a room beside the corridor or the first
+  // lamp of a side corridor falls outside it, and every corridor of a regular building looks
+  // the same to the screen.
+  double screen_max_theta_deg = 80.0;
+  double max_theta_deg = 88.0;         // lamps and blobs used to score a pose
   double expect_max_theta_deg = 80.0;  // a lamp further off-axis may be missed without cost
   double detection_sigma_deg = 0.1;    // a blob's direction
   // In enumerate(), a seed's lamp may be off where its blob's centroid puts it by this
@@ -94,7 +100,7 @@ struct LampMatch {
 struct PoseHypothesis {
   Pose2 pose;                                                // robot base in the map
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // x, y, yaw
-  double merit = 0;     // paper 1's M(P) in pixels (lower is better)
+  double merit = 0;     // paper 1's M(P) in pixels (lower is better); NaN from enumerate()
   double score = 0;     // -2 log likelihood (default method; lower is better)
   double weight = 1;    // share of the hypotheses' likelihood (they sum to 1)
   int expected = 0;     // lamps in clear view from this pose
