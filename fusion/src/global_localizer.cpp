@@ -438,8 +438,10 @@ GlobalLocalizer::Impl::Solution GlobalLocalizer::Impl::solve(Pose2 pose, Tilt ti
     const Vector5d step = (JtJ + 1e-12 * Matrix5d::Identity()).ldlt().solve(Jtr);
     if (!step.allFinite()) break;
     pose = Pose2(pose.x() + step(0), pose.y() + step(1), wrap_angle(pose.yaw() + step(2)));
-    tilt.roll += step(3);
-    tilt.pitch += step(4);
+    if (with_tilt) {
+      tilt.roll += step(3);
+      tilt.pitch += step(4);
+    }
     if (step.head<2>().norm() < 1e-5 && step.tail<3>().cwiseAbs().maxCoeff() < 1e-7) break;
   }
   const Matrix5d cov = (JtJ + 1e-12 * Matrix5d::Identity()).inverse();

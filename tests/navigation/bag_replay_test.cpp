@@ -2,8 +2,12 @@
 // written again as a bag (wheel odometry as nav_msgs/msg/Odometry integrated the way ROS's
 // diff_drive_controller does, images as sensor_msgs/msg/CompressedImage, header stamps the
 // capture times, log times the arrivals), replayed with the robot's semi-axis, gives the same
-// estimates to 1e-9 m, the same mode changes, and the same metrics that need no truth (a bag
-// carries none).
+// mode changes, the same metrics that need no truth (a bag carries none), and the same estimates
+// within 5 mm. Not to the last bit: the wheel readings rebuilt from the bag's poses differ from
+// the log's by an offset and in the last bits of their increments, and a decision at its
+// boundary may go the other way. Until 2026-11-26 the estimates agreed to 1e-13 m; with the
+// global search's screen widened to 80 degrees, one frame 48 s after the relocalization moves
+// the bag's estimate 0.7 mm (1.4 mm at most, 8 um by the end).
 
 #include <unistd.h>
 
@@ -97,7 +101,7 @@ TEST(BagReplay, ABagOfTheOfficeMissionGivesTheSameEstimates) {
   }
   std::cout << a.estimates.size() << " estimates, the bag's at most " << worst * 1000
             << " mm from the log's\n";
-  EXPECT_LE(worst, 1e-9);
+  EXPECT_LE(worst, 5e-3);
   ASSERT_EQ(a.events.size(), b.events.size());
   for (std::size_t k = 0; k < a.events.size(); ++k) {
     EXPECT_EQ(a.events[k].stamp, b.events[k].stamp) << k;
