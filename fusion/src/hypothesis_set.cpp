@@ -440,8 +440,8 @@ struct HypothesisSet::Impl {
     ++counts.enumerations;
     const double margin = -2 * std::log(o.birth_ratio);
     const EnumerationPrior prior = o.carry_places ? carry_places(stamp, odo) : EnumerationPrior{};
-    const std::uint64_t restarts_before = counts.place_restarts;
     const bool with_prior = !prior.poses.empty();
+    bool r_with_prior = with_prior;  // r was enumerated within the carried places
     GlobalLocalization r =
         omni->enumerate(d, o.max_hypotheses, margin, with_prior ? &prior : nullptr);
     std::vector<Place> missed;
@@ -453,6 +453,7 @@ struct HypothesisSet::Impl {
         // Start again from this image alone.
         ++counts.place_restarts;
         r = omni->enumerate(d, o.max_hypotheses, margin);
+        r_with_prior = false;
         missed = update_places(r, nullptr, stamp, odo);
       }
     }
@@ -467,13 +468,11 @@ struct HypothesisSet::Impl {
     // What the drive said before this image: each hypothesis is born with the cost of the
     // carried place it continues (the least within the gate), so that the places the drive has
     // told apart from the truth are born behind it, not level with it.
-    const bool r_with_prior = with_prior && counts.place_restarts == restarts_before;
     std::optional<detail::PoseGrid> drive;
     if (r_with_prior) drive.emplace(prior.poses, prior.gate_m, &prior.costs);
     const auto drive_cost = [&](const Pose2& p) {
       if (!drive) return 0.0;
-      const double c = drive->least(p, prior.gate_m, prior.gate_rad);
-      return c < o.place_cost_max ? c : o.place_cost_max;
+      return std::min(drive->least(p, prior.gate_m, prior.gate_rad), o.place_cost_max);
     };
     const auto cost_of = [&](const PoseHypothesis& h) {
       return h.score - best_score + drive_cost(h.pose);

@@ -3,11 +3,11 @@
 // diff_drive_controller does, images as sensor_msgs/msg/CompressedImage, header stamps the
 // capture times, log times the arrivals), replayed with the robot's semi-axis, gives the same
 // mode changes, the same metrics that need no truth (a bag carries none), and the same estimates
-// within 5 mm. Not to the last bit: the wheel readings rebuilt from the bag's poses differ from
-// the log's by an offset and in the last bits of their increments, and a decision at its
-// boundary may go the other way. Until 2026-11-26 the estimates agreed to 1e-13 m; with the
-// global search's screen widened to 80 degrees, one frame 48 s after the relocalization moves
-// the bag's estimate 0.7 mm (1.4 mm at most, 8 um by the end).
+// within 5 mm. Not to the last bit: the wheel readings rebuilt from the bag's poses are not the
+// log's (every one of the 7,108 differs, by up to 9.6 mm), and some decision in the localizer
+// goes the other way (which one was not found). Until 2026-11-26 the estimates agreed to
+// 1e-13 m; with the global search's screen widened to 80 degrees, the bag's estimate moves
+// 0.7 mm 48 s after the relocalization (1.4 mm at most, 8 um by the end).
 
 #include <unistd.h>
 

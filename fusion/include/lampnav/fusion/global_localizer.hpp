@@ -57,10 +57,10 @@ struct LampPairOptions {
   double pair_max_theta_deg = 75.0;  // detections used to form pairs (further off-axis: imprecise)
   int pair_max_blobs = 12;           // at most this many, nearest the optical axis first
   // enumerate() screens every candidate pose on the lamps and blobs within this angle of the
-  // axis: the cone in which the omni camera places a lamp well (on the robots of maps/robots,
-  // within 0.15 m up to about 80 degrees). Narrower, a room beside the corridor or the first
-  // lamp of a side corridor falls outside it, and every corridor of a regular building looks
-  // the same to the screen.
+  // axis: the cone in which the omni camera places a lamp well (on maps/robots/pioneer.json,
+  // 0.9 m under the lamps, within 0.15 m up to 79.8 degrees). Narrower, a room beside the corridor
+  // or the first lamp of a side corridor falls outside it, and every corridor of a regular building
+  // looks the same to the screen.
   double screen_max_theta_deg = 80.0;
   double max_theta_deg = 88.0;         // lamps and blobs used to score a pose
   double expect_max_theta_deg = 80.0;  // a lamp further off-axis may be missed without cost
