@@ -314,9 +314,15 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
     out.candidate_costs.push_back(scored[k].drive);
   }
   const std::size_t within = std::min(in_reach, limit + 1);  // over the limit: incomplete
+  // With two seeds, or more candidates in reach than the limit, the search cannot be complete:
+  // its hypotheses are shown, not born as the set, and only the `cap` it returns are refined
+  // (not four times as many, nor scored again with the floor's tilt, below). Those searches
+  // were two thirds of a kidnapped robot's time on 100 nodes (docs/performance.md).
+  const bool can_be_complete = ns >= 3 && in_reach <= limit;
   // One round each, at a level floor: enough to rank the candidates; the hypothesis set refines
   // in full.
-  std::vector<PoseHypothesis> refined(std::min(in_reach, limit));
+  std::vector<PoseHypothesis> refined(
+      std::min(in_reach, can_be_complete ? limit : std::size_t(cap)));
   for_each_costly_index(refined.size(), serial_up_to(2), [&](std::size_t k) {
     refined[k] = refine(scored[k].pose, 0.3, 3 * kDeg, blobs, 1, false);
   });
@@ -324,7 +330,7 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   // of the true pose more than the birth margin on the wide view (33 against 7 with the tilt,
   // on a 1,000-node kidnap). When the best candidate, refined with the tilt, finds the floor
   // tilted, every candidate is scored again holding that tilt, so that they compare.
-  if (!refined.empty()) {
+  if (can_be_complete && !refined.empty()) {
     std::size_t b = 0;
     for (std::size_t k = 1; k < refined.size(); ++k)
       if (refined[k].score < refined[b].score) b = k;
