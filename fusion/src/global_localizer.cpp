@@ -472,8 +472,14 @@ PoseHypothesis GlobalLocalizer::Impl::refine(Pose2 pose, double position_sigma, 
     const double ys = std::min(yaw_sigma, std::max(0.5 * kDeg, std::sqrt(cov(2, 2))));
     ts = &sol == &level ? tilt_sigma : std::min(tilt_sigma, std::sqrt(sol.tilt_covariance.trace()));
     // Matched again with the tolerance the solution earned, for the next round (after the last,
-    // the score below matches anew).
-    if (round + 1 < rounds) e = evaluate(pose, tilt, ps, ys, ts, blobs);
+    // the score below matches anew). When the lamps and blobs matched are those just solved on,
+    // the next round would start at its own solution: the pose has converged.
+    if (round + 1 < rounds) {
+      Evaluation next = evaluate(pose, tilt, ps, ys, ts, blobs);
+      const bool converged = next.matches == e.matches;
+      e = std::move(next);
+      if (converged) break;
+    }
   }
   // Scored with one common tolerance, so hypotheses compare.
   e = evaluate(pose, tilt, 0.05, 0.5 * kDeg, ts, blobs);
