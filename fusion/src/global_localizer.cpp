@@ -382,17 +382,24 @@ GlobalLocalizer::Impl::Solution GlobalLocalizer::Impl::solve(Pose2 pose, Tilt ti
                                                              const Evaluation& e,
                                                              const std::vector<BlobRay>& blobs,
                                                              bool with_tilt) const {
-  using Matrix5d = Eigen::Matrix<double, 5, 5>;
-  using Vector5d = Eigen::Matrix<double, 5, 1>;
+  // A held tilt leaves the pose's three unknowns alone: a third of the work of five.
+  return with_tilt ? solve_for<5>(pose, tilt, e, blobs) : solve_for<3>(pose, tilt, e, blobs);
+}
+
+template <int N>
+GlobalLocalizer::Impl::Solution GlobalLocalizer::Impl::solve_for(
+    Pose2 pose, Tilt tilt, const Evaluation& e, const std::vector<BlobRay>& blobs) const {
+  static_assert(N == 3 || N == 5, "the pose, with or without the floor's tilt");
+  using MatrixNd = Eigen::Matrix<double, N, N>;
+  using VectorNd = Eigen::Matrix<double, N, 1>;
   const double det = o.pairs.detection_sigma_deg * kDeg;
-  const double tilt_prior =
-      with_tilt ? 1.0 / std::pow(std::max(1e-6, o.pairs.tilt_sigma_deg * kDeg), 2) : 1e16;
-  Matrix5d JtJ = Matrix5d::Identity();
+  const double tilt_prior = 1.0 / std::pow(std::max(1e-6, o.pairs.tilt_sigma_deg * kDeg), 2);
+  MatrixNd JtJ = MatrixNd::Identity();
   double cost = 0;
   for (int iter = 0; iter < 8; ++iter) {
     JtJ.setZero();
     cost = 0;
-    Vector5d Jtr = Vector5d::Zero();
+    VectorNd Jtr = VectorNd::Zero();
     const double c = std::cos(pose.yaw()), s = std::sin(pose.yaw());
     Matrix3d Rz_t, dRz_t;
     Rz_t << c, s, 0, -s, c, 0, 0, 0, 1;
@@ -410,13 +417,15 @@ GlobalLocalizer::Impl::Solution GlobalLocalizer::Impl::solve(Pose2 pose, Tilt ti
       const double n = cpt.norm();
       const Vector3d ray = cpt / n;
       const Matrix3d dn = (Matrix3d::Identity() - ray * ray.transpose()) / n;
-      Eigen::Matrix<double, 3, 5> dc;
+      Eigen::Matrix<double, 3, N> dc;
       dc.col(0) = d_by_x;
       dc.col(1) = d_by_y;
       dc.col(2) = mount_Rt * (T * (dRz_t * d));
-      dc.col(3) = mount_Rt * (dT_roll * b);
-      dc.col(4) = mount_Rt * (dT_pitch * b);
-      const Eigen::Matrix<double, 3, 5> J = dn * dc;
+      if constexpr (N == 5) {
+        dc.col(3) = mount_Rt * (dT_roll * b);
+        dc.col(4) = mount_Rt * (dT_pitch * b);
+      }
+      const Eigen::Matrix<double, 3, N> J = dn * dc;
       const Vector3d r = blobs[bj].ray - ray;
       const double face = face_sigma(*lamps[li], n);
       const double s2 = det * det + face * face + 0.01 * std::pow(blobs[bj].angular_radius, 2);
@@ -425,27 +434,33 @@ GlobalLocalizer::Impl::Solution GlobalLocalizer::Impl::solve(Pose2 pose, Tilt ti
       const double z = r.norm() / std::sqrt(s2);
       const double w = (z > 2 ? 2 / z : 1.0) / s2;
       cost += z > 2 ? 4 * z - 4 : z * z;
-      JtJ += w * J.transpose() * J;
-      Jtr += w * J.transpose() * r;
+      JtJ.noalias() += w * J.transpose() * J;
+      Jtr.noalias() += w * J.transpose() * r;
     }
-    if (with_tilt) cost += tilt_prior * (tilt.roll * tilt.roll + tilt.pitch * tilt.pitch);
-    JtJ(3, 3) += tilt_prior;
-    JtJ(4, 4) += tilt_prior;
-    if (with_tilt) {  // the prior pulls toward a level floor; else the tilt is held as given
+    if constexpr (N == 5) {  // the prior pulls toward a level floor
+      cost += tilt_prior * (tilt.roll * tilt.roll + tilt.pitch * tilt.pitch);
+      JtJ(3, 3) += tilt_prior;
+      JtJ(4, 4) += tilt_prior;
       Jtr(3) -= tilt_prior * tilt.roll;
       Jtr(4) -= tilt_prior * tilt.pitch;
     }
-    const Vector5d step = (JtJ + 1e-12 * Matrix5d::Identity()).ldlt().solve(Jtr);
+    const VectorNd step = (JtJ + 1e-12 * MatrixNd::Identity()).ldlt().solve(Jtr);
     if (!step.allFinite()) break;
     pose = Pose2(pose.x() + step(0), pose.y() + step(1), wrap_angle(pose.yaw() + step(2)));
-    if (with_tilt) {
+    if constexpr (N == 5) {
       tilt.roll += step(3);
       tilt.pitch += step(4);
     }
-    if (step.head<2>().norm() < 1e-5 && step.tail<3>().cwiseAbs().maxCoeff() < 1e-7) break;
+    if (step.template head<2>().norm() < 1e-5 &&
+        step.template tail<N - 2>().cwiseAbs().maxCoeff() < 1e-7)
+      break;
   }
-  const Matrix5d cov = (JtJ + 1e-12 * Matrix5d::Identity()).inverse();
-  return {pose, tilt, cov.topLeftCorner<3, 3>(), cov.bottomRightCorner<2, 2>(), cost};
+  const MatrixNd cov = (JtJ + 1e-12 * MatrixNd::Identity()).inverse();
+  if constexpr (N == 5)
+    return {pose, tilt, cov.template topLeftCorner<3, 3>(),
+            cov.template bottomRightCorner<2, 2>(), cost};
+  else  // held: known exactly
+    return {pose, tilt, cov, Eigen::Matrix2d::Zero(), cost};
 }
 
 PoseHypothesis GlobalLocalizer::Impl::refine(Pose2 pose, double position_sigma, double yaw_sigma,

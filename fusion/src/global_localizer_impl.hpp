@@ -196,6 +196,10 @@ struct GlobalLocalizer::Impl {
   // Without `with_tilt` the tilt is held as given (zero: a level floor).
   Solution solve(Pose2 pose, Tilt tilt, const Evaluation& e, const std::vector<BlobRay>& blobs,
                  bool with_tilt) const;
+  // N = 5: the pose and the tilt; N = 3: the pose, the tilt held.
+  template <int N>
+  Solution solve_for(Pose2 pose, Tilt tilt, const Evaluation& e,
+                     const std::vector<BlobRay>& blobs) const;
 
   // Refines a pose: match, solve, match again with the tolerance the solution earned.
   // `rounds` of match-and-solve; `with_tilt`: the floor's tilt estimated too (three times
