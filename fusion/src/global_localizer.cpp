@@ -11,6 +11,7 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <utility>
 
 #include "global_localizer_impl.hpp"
 #include "lampnav/core/error.hpp"
@@ -405,7 +406,8 @@ GlobalLocalizer::Impl::Solution GlobalLocalizer::Impl::solve_for(
     Rz_t << c, s, 0, -s, c, 0, 0, 0, 1;
     dRz_t << -s, c, 0, -c, -s, 0, 0, 0, 0;
     const Matrix3d T = tilt.inverse_rotation();
-    const auto [dT_roll, dT_pitch] = tilt.inverse_rotation_derivatives();
+    std::pair<Matrix3d, Matrix3d> dT;  // by roll and by pitch, when they are unknowns
+    if constexpr (N == 5) dT = tilt.inverse_rotation_derivatives();
     // A lamp's point moves alike for every lamp as the robot moves along x or y.
     const Vector3d d_by_x = mount_Rt * (T * (Rz_t * Vector3d(-1, 0, 0)));
     const Vector3d d_by_y = mount_Rt * (T * (Rz_t * Vector3d(0, -1, 0)));
@@ -422,8 +424,8 @@ GlobalLocalizer::Impl::Solution GlobalLocalizer::Impl::solve_for(
       dc.col(1) = d_by_y;
       dc.col(2) = mount_Rt * (T * (dRz_t * d));
       if constexpr (N == 5) {
-        dc.col(3) = mount_Rt * (dT_roll * b);
-        dc.col(4) = mount_Rt * (dT_pitch * b);
+        dc.col(3) = mount_Rt * (dT.first * b);
+        dc.col(4) = mount_Rt * (dT.second * b);
       }
       const Eigen::Matrix<double, 3, N> J = dn * dc;
       const Vector3d r = blobs[bj].ray - ray;
@@ -457,8 +459,8 @@ GlobalLocalizer::Impl::Solution GlobalLocalizer::Impl::solve_for(
   }
   const MatrixNd cov = (JtJ + 1e-12 * MatrixNd::Identity()).inverse();
   if constexpr (N == 5)
-    return {pose, tilt, cov.template topLeftCorner<3, 3>(),
-            cov.template bottomRightCorner<2, 2>(), cost};
+    return {pose, tilt, cov.template topLeftCorner<3, 3>(), cov.template bottomRightCorner<2, 2>(),
+            cost};
   else  // held: known exactly
     return {pose, tilt, cov, Eigen::Matrix2d::Zero(), cost};
 }

@@ -313,11 +313,10 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
     out.candidates.push_back(scored[k].pose);
     out.candidate_costs.push_back(scored[k].drive);
   }
-  const std::size_t within = std::min(in_reach, limit + 1);  // over the limit: incomplete
   // With two seeds, or more candidates in reach than the limit, the search cannot be complete:
   // its hypotheses are shown, not born as the set, and only the `cap` it returns are refined
   // (not four times as many, nor scored again with the floor's tilt, below). Those searches
-  // were two thirds of a kidnapped robot's time on 100 nodes (docs/performance.md).
+  // were two thirds of the enumerations' time on the 100-node kidnaps (docs/hypotheses.md).
   const bool can_be_complete = ns >= 3 && in_reach <= limit;
   // One round each, at a level floor: enough to rank the candidates; the hypothesis set refines
   // in full.
@@ -366,7 +365,7 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
     if (h.score <= out.hypotheses.front().score + margin) ++kept;
   // With two seeds, one blob off its lamp (merged with a neighbour, or cut) hides the true
   // place; with three, the pair of the other two still finds it.
-  out.complete = out.found() && ns >= 3 && within <= limit && kept <= std::size_t(cap);
+  out.complete = out.found() && can_be_complete && kept <= std::size_t(cap);
   if (out.hypotheses.size() > std::size_t(cap)) out.hypotheses.resize(cap);
   if (!out.complete && out.found() && ns < 3)
     out.why = "two lamps near the zenith fit " + std::to_string(std::max(kept, in_reach)) +
