@@ -315,7 +315,8 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     for (std::size_t j = 0; j < blobs.size(); ++j) {
       const double s2 = sigma2 + blob_term[j];
       const double chord2 = (pred[i].ray - blobs[j].ray).squaredNorm();
-      if (chord2 < reach * reach) pred[i].covered = true;
+      const double cover = reach + blobs[j].angular_radius;  // the blob spans its own size
+      if (chord2 < cover * cover) pred[i].covered = true;
       if (chord2 > 9.0 * (1 + 1e-9) * s2) continue;  // beyond 3 sigma, rounding aside
       const double d2 = chord2 / s2;
       if (d2 <= 9.0) {

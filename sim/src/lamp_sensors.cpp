@@ -41,6 +41,7 @@ void LampSensorOptions::validate() const {
     if (!ok) throw InputError({"", "lamp sensors", field}, what);
   };
   check(omni_sigma_deg >= 0, "omni_sigma_deg");
+  check(omni_halo > 0, "omni_halo", "must be positive");
   check(omni_max_theta_deg > 0 && omni_max_theta_deg < 180, "omni_max_theta_deg",
         "must be between 0 and 180 degrees");
   check(ceiling_sigma_px >= 0, "ceiling_sigma_px");
@@ -123,8 +124,12 @@ vision::OmniDetection LampSensors::omni(const Pose2& pose, std::mt19937_64& rng)
     if (!(range > 0.1)) continue;
     const Vector3d ray = c / range;
     if (std::acos(std::clamp(ray.z(), -1.0, 1.0)) > m.o.omni_max_theta_deg * kDeg) continue;
-    // The bloom makes a blob about as wide as the lamp is long, seen from its range.
-    seen.push_back({ray, std::max(0.05, l->length) / range});
+    // The IR bloom makes a blob omni_halo times the lamp's face (a disc of its area), seen
+    // from its range: the rendered blob's core (OmniRenderOptions::halo).
+    const double w = l->width > 0 ? l->width : l->length;
+    const double face =
+        l->shape == graph::LampShape::disc ? 0.5 * l->length : std::sqrt(l->length * w / M_PI);
+    seen.push_back({ray, m.o.omni_halo * std::atan(std::max(0.025, face) / range)});
   }
   // One blob per lamp: the detector's second threshold splits lamps whose blooms touch.
   for (const Seen& sn : seen) {

@@ -54,10 +54,10 @@ struct HypothesisSetOptions {
   double place_gate_m = 1.0, place_gate_deg = 12.0;
   double place_cost_max = 30.0;
   // An image's cost a place is let off (EnumerationPrior::view_allowance). The truth's own
-  // cost on rendered views has a median of 2 and is often 4.6 (a lamp missed) or 6 (a blob
-  // odd), so these add up over a long drive; but letting them off slows the pruning: on the
-  // 1,000-node kidnaps, 4.6 fixed 5 of 10 and 2 fixed 9 of 10 after a median of 163 m, against
-  // 9 of 10 after 108 m with none (docs/hypotheses.md).
+  // cost on rendered views has a median of 2 and is often 4.6 (a lamp missed, when a miss
+  // cost that) or 6 (a blob odd), so these add up over a long drive; but letting them off
+  // slows the pruning: on the 1,000-node kidnaps, 4.6 fixed 5 of 10 and 2 fixed 9 of 10 after
+  // a median of 163 m, against 9 of 10 after 108 m with none (docs/hypotheses.md).
   double place_allowance = 0.0;
   double drop_ratio = 1e-9;               // hypotheses below this likelihood ratio to the best die
   double birth_ratio = 1e-4;              // an image gives birth to the places within this ratio of

@@ -25,6 +25,7 @@ namespace lampnav::sim {
 struct LampSensorOptions {
   double omni_sigma_deg = 0.1;               // a blob's direction
   double omni_max_theta_deg = 88.0;          // blobs further off the axis are not reported
+  double omni_halo = 1.6;                    // a blob's radius / its lamp face's (IR bloom)
   double ceiling_sigma_px = 0.3;             // a lamp's centre
   double ceiling_orientation_sigma = 0.004;  // rad, its axis
   double bump_sigma_deg = 0.5;               // floor bumps: both cameras tilt alike in one instant
