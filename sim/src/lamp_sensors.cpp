@@ -6,6 +6,7 @@
 #include <optional>
 
 #include "lampnav/core/error.hpp"
+#include "lampnav/sim/renderers.hpp"
 #include "lampnav/vision/camera_models.hpp"
 
 namespace lampnav::sim {
@@ -126,10 +127,7 @@ vision::OmniDetection LampSensors::omni(const Pose2& pose, std::mt19937_64& rng)
     if (std::acos(std::clamp(ray.z(), -1.0, 1.0)) > m.o.omni_max_theta_deg * kDeg) continue;
     // The IR bloom makes a blob omni_halo times the lamp's face (a disc of its area), seen
     // from its range: the rendered blob's core (OmniRenderOptions::halo).
-    const double w = l->width > 0 ? l->width : l->length;
-    const double face =
-        l->shape == graph::LampShape::disc ? 0.5 * l->length : std::sqrt(l->length * w / M_PI);
-    seen.push_back({ray, m.o.omni_halo * std::atan(std::max(0.025, face) / range)});
+    seen.push_back({ray, m.o.omni_halo * std::atan(std::max(0.025, lamp_face_radius(*l)) / range)});
   }
   // One blob per lamp: the detector's second threshold splits lamps whose blooms touch.
   for (const Seen& sn : seen) {

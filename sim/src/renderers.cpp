@@ -210,6 +210,11 @@ std::optional<Vector2d> OmniRenderer::project(const Pose2& robot, const CameraTi
   return model.project(camera_pose(robot, tilt, cam_.mount).to_camera(p_map));
 }
 
+double lamp_face_radius(const graph::Lamp& lamp) {
+  return lamp.shape == graph::LampShape::disc ? lamp.length / 2
+                                              : std::sqrt(lamp.length * lamp.width / M_PI);
+}
+
 Image8 OmniRenderer::render(const Pose2& robot, const CameraTilt& tilt,
                             const std::vector<const graph::Lamp*>& lamps,
                             std::mt19937_64& rng) const {
@@ -258,10 +263,7 @@ Image8 OmniRenderer::render(const Pose2& robot, const CameraTilt& tilt,
     const double dist = pc.norm();
     const double theta = std::atan2(std::hypot(pc.x(), pc.y()), pc.z());
     if (theta > 50.0 * M_PI / 180.0 && uni(rng) < o_.occlusion_probability) continue;  // a person
-    const double face_radius = lamp->shape == graph::LampShape::disc
-                                   ? lamp->length / 2
-                                   : std::sqrt(lamp->length * lamp->width / M_PI);
-    const double ang = std::atan(face_radius / dist);
+    const double ang = std::atan(lamp_face_radius(*lamp) / dist);
     const double core = std::max(o_.min_radius_px, o_.halo * ang * px_per_rad(theta));
     double halo_r = core, halo_level = o_.background;
     if (dist < o_.near_bloom_m) {

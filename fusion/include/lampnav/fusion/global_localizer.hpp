@@ -72,8 +72,8 @@ struct LampPairOptions {
   double tilt_sigma_deg = 0.6;  // floor bumps swing the camera
   // -2 ln 0.01: a lamp in clear view (expect_max_theta_deg) that no blob matched and, where its
   // neighbours' blobs may merge with its own, no blob covers. On rendered views from the true
-  // pose (people hiding 8 % of the lamps past 50 degrees, floor bumps), 0.5 to 1.2 % of such
-  // lamps are missed (docs/hypotheses.md).
+  // pose (people hiding 8 % of the lamps past 50 degrees, floor bumps), 0.2 % of such lamps
+  // are missed (0.6 to 1.2 % before a blob's size counted in covering; docs/hypotheses.md).
   double miss_cost = 9.2;
   double spurious_cost = 6.0;     // a blob no lamp explains
   double ambiguity_margin = 9.2;  // hypotheses within this of the best (2 ln 100) remain

@@ -17,20 +17,21 @@
 #include "lampnav/core/pose2.hpp"
 #include "lampnav/core/robot_description.hpp"
 #include "lampnav/graph/map.hpp"
+#include "lampnav/sim/renderers.hpp"
 #include "lampnav/vision/lamp_detector.hpp"
 #include "lampnav/vision/omni_detector.hpp"
 
 namespace lampnav::sim {
 
 struct LampSensorOptions {
-  double omni_sigma_deg = 0.1;               // a blob's direction
-  double omni_max_theta_deg = 88.0;          // blobs further off the axis are not reported
-  double omni_halo = 1.6;                    // a blob's radius / its lamp face's (IR bloom)
-  double ceiling_sigma_px = 0.3;             // a lamp's centre
-  double ceiling_orientation_sigma = 0.004;  // rad, its axis
-  double bump_sigma_deg = 0.5;               // floor bumps: both cameras tilt alike in one instant
-  std::set<std::string> failed_lamps;        // lamp ids that do not light
-  void validate() const;                     // throws InputError naming the field
+  double omni_sigma_deg = 0.1;                  // a blob's direction
+  double omni_max_theta_deg = 88.0;             // blobs further off the axis are not reported
+  double omni_halo = OmniRenderOptions{}.halo;  // a blob's radius / its lamp face's (IR bloom)
+  double ceiling_sigma_px = 0.3;                // a lamp's centre
+  double ceiling_orientation_sigma = 0.004;     // rad, its axis
+  double bump_sigma_deg = 0.5;         // floor bumps: both cameras tilt alike in one instant
+  std::set<std::string> failed_lamps;  // lamp ids that do not light
+  void validate() const;               // throws InputError naming the field
 };
 
 class LampSensors {

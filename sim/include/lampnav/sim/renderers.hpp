@@ -58,6 +58,10 @@ class CeilingRenderer {
   std::unique_ptr<Impl> impl_;
 };
 
+// The radius (m) of a disc of a lamp's face: a disc lamp's own, a rectangle's of equal area. The
+// omni camera's IR bloom grows a blob from it (OmniRenderOptions::halo).
+double lamp_face_radius(const graph::Lamp& lamp);
+
 struct OmniRenderOptions {
   double background = 8.0;              // grey level
   double peak = 255.0;                  // a lamp's core saturates the IR-filtered sensor
