@@ -60,6 +60,7 @@ void GlobalLocalizerOptions::validate() const {
         "sigmas must be positive");
   check(q.miss_cost >= 0 && q.spurious_cost >= 0 && q.ambiguity_margin >= 0, "pairs.miss_cost",
         "costs must not be negative");
+  check(q.cover_sigmas >= 0 && q.cover_sigmas <= 10, "pairs.cover_sigmas", "must be 0 to 10");
   check(q.distinct_m > 0 && q.distinct_deg > 0, "pairs.distinct_m", "must be positive");
   check(q.candidates >= 1 && q.refined >= 1 && q.refined <= q.candidates, "pairs.candidates",
         "must be positive, with refined <= candidates");
@@ -266,7 +267,6 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     double theta, sigma, half_size;
     int lamp;
     bool crowded = false, matched = false;
-    bool covered = false;  // some blob lies over it (crowded lamps: seen, if merged)
   };
   std::vector<Predicted> pred;
   const Vector2d mount_xy = pose.transform_from(mount_t.head<2>());
@@ -310,13 +310,10 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
   for (std::size_t j = 0; j < blobs.size(); ++j)
     blob_term[j] = 0.25 * blobs[j].angular_radius * blobs[j].angular_radius;
   for (std::size_t i = 0; i < pred.size(); ++i) {
-    const double reach = pred[i].half_size + 3 * pred[i].sigma;
     const double sigma2 = pred[i].sigma * pred[i].sigma;
     for (std::size_t j = 0; j < blobs.size(); ++j) {
       const double s2 = sigma2 + blob_term[j];
       const double chord2 = (pred[i].ray - blobs[j].ray).squaredNorm();
-      const double cover = reach + blobs[j].angular_radius;  // the blob spans its own size
-      if (chord2 < cover * cover) pred[i].covered = true;
       if (chord2 > 9.0 * (1 + 1e-9) * s2) continue;  // beyond 3 sigma, rounding aside
       const double d2 = chord2 / s2;
       if (d2 <= 9.0) {
@@ -365,11 +362,20 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     e.matches.emplace_back(pred[p.p].lamp, p.b);
   }
   // A lamp in clear view is missing when no blob matched it; one crowded by its neighbours only
-  // when no blob lies over it either.
+  // when no blob lies over it either: within the lamp's size and cover_sigmas of its direction's
+  // sigma, widened by the blob's own size (a merged blob spans its lamps).
+  const auto covered = [&](const Predicted& p) {
+    const double reach = p.half_size + q.cover_sigmas * p.sigma;
+    for (const BlobRay& b : blobs) {
+      const double cover = reach + b.angular_radius;
+      if ((p.ray - b.ray).squaredNorm() < cover * cover) return true;
+    }
+    return false;
+  };
   for (const Predicted& p : pred) {
     if (p.theta > expect_theta) continue;
     ++e.expected;
-    if (!p.matched && !(p.crowded && p.covered)) ++e.missing;
+    if (!p.matched && !(p.crowded && covered(p))) ++e.missing;
   }
   for (std::size_t j = 0; j < blobs.size(); ++j)
     if (!b_used[j] && !explained[j]) ++e.unexplained;

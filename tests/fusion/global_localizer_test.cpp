@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <random>
 
+#include "battery.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/global_localizer.hpp"
 #include "lampnav/fusion/merit.hpp"
@@ -482,6 +483,35 @@ TEST(GlobalLocalizer, ACrossingCannotPassForACorner) {
       EXPECT_GE(at_twin->score, at_truth->score + 2 * global.options().pairs.miss_cost - 3.0)
           << "heading " << k << ", crossing turned " << j;
     }
+  }
+}
+
+// Kidnap 5003 of the 1,000-node battery (docs/hypotheses.md): the robot comes north up a
+// corridor to a T whose north arm is the building's missing corridor; its twin, 40 m south, is a
+// crossing whose north arm has lamps every 2.7 m. From a few metres before the junction the
+// twin's first lamp down that arm is in clear view (76 to 80 degrees off-axis), crowded by the
+// arm's further lamps, and in line with the blob of the next corridor's lamps 20 m on. That blob
+// is not the arm's: the twin must count the lamp missed. With a crowded lamp covered anywhere
+// within 3 sigma of that blob (before 2026-11-26), it was not, and the twin kept its weight for
+// 200 s of identical corridors.
+TEST(GlobalLocalizer, ALampDownASideCorridorTheViewLacksIsMissed) {
+  const Museum m;  // for the robot
+  const graph::TopologicalMap map =
+      graph::parse_map(sim::generate_building(test::asymmetric_building(1000)).geojson, "g").map;
+  const auto lamp_near = [&](const Vector2d& p) { return !map.lamps_within(p, 0.3).empty(); };
+  ASSERT_FALSE(lamp_near({320, 203.25})) << "the generated building changed: pick another T";
+  ASSERT_TRUE(lamp_near({320, 163.25})) << "the generated building changed: pick another T";
+  const GlobalLocalizer global(map, m.cam());
+  for (const double before : {0.0, 0.5}) {
+    const Pose2 truth(320, 200 - before, M_PI / 2), twin(320, 160 - before, M_PI / 2);
+    const auto d = render_and_detect(m.cam(), map, truth, 11);
+    const auto at_truth = global.refine(truth, 0.05, 0.02, d);
+    const auto at_twin = global.refine(twin, 0.05, 0.02, d);
+    ASSERT_TRUE(at_truth && at_twin);
+    EXPECT_EQ(at_truth->missing, 0) << before << " m before the junction";
+    EXPECT_GE(at_twin->missing, 1) << before << " m before the junction";
+    EXPECT_GE(at_twin->score, at_truth->score + global.options().pairs.miss_cost - 3.0)
+        << before << " m before the junction";
   }
 }
 
