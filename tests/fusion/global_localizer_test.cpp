@@ -515,6 +515,31 @@ TEST(GlobalLocalizer, ALampDownASideCorridorTheViewLacksIsMissed) {
   }
 }
 
+// Options out of range are refused by name, before any image is read.
+TEST(GlobalLocalizer, RefusesBadOptionsNamingThem) {
+  const Museum m;
+  const auto refused = [&](const GlobalLocalizerOptions& o) -> std::string {
+    try {
+      const GlobalLocalizer global(m.map, m.cam(), o);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  GlobalLocalizerOptions o;
+  EXPECT_EQ(refused(o), "");
+  o.pairs.cover_sigmas = -1;
+  EXPECT_THAT(refused(o), testing::HasSubstr("pairs.cover_sigmas"));
+  o.pairs.cover_sigmas = std::nan("");
+  EXPECT_THAT(refused(o), testing::HasSubstr("pairs.cover_sigmas"));
+  o = {};
+  o.pairs.miss_cost = -9.2;
+  EXPECT_THAT(refused(o), testing::HasSubstr("pairs.miss_cost"));
+  o = {};
+  o.max_hypotheses = 0;
+  EXPECT_THAT(refused(o), testing::HasSubstr("max_hypotheses"));
+}
+
 TEST(GlobalLocalizer, HonoursTheCameraMount) {
   Museum m;
   CameraDescription cam = m.cam();
