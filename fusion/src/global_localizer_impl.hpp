@@ -30,6 +30,70 @@ struct BlobRay {
   int index;  // into the detection's blobs
 };
 
+// The blobs of one image by where their rays point, to find those within a chord of a ray
+// without trying every blob (a 1,000-node building's view holds 80 blobs and 100 lamps). Rays
+// are binned by their x and y, which no chord is shorter than. Blobs of more than kSmall rad
+// (a lamp nearly overhead) are few and wide: they are tried for every ray, so that a query's
+// reach needs to allow only for the largest small blob.
+class RayGrid {
+ public:
+  static constexpr double kSmall = 0.06;
+  // Up to kFew blobs are all tried for every ray: binning them would cost more than it saves.
+  static constexpr std::size_t kFew = 12;
+  // Bins the blobs (the storage of an earlier build kept).
+  void build(const std::vector<BlobRay>& blobs) {
+    wide_.clear();
+    index_.clear();
+    largest_term_ = 0;
+    if (blobs.size() <= kFew) {
+      for (std::size_t j = 0; j < blobs.size(); ++j) wide_.push_back(static_cast<int>(j));
+      return;
+    }
+    cell_of_.assign(blobs.size(), -1);
+    start_.assign(kCells * kCells + 1, 0);
+    for (std::size_t j = 0; j < blobs.size(); ++j) {
+      if (blobs[j].angular_radius > kSmall) {
+        wide_.push_back(static_cast<int>(j));
+        continue;
+      }
+      largest_term_ =
+          std::max(largest_term_, 0.25 * blobs[j].angular_radius * blobs[j].angular_radius);
+      cell_of_[j] = bin(blobs[j].ray.y()) * kCells + bin(blobs[j].ray.x());
+      ++start_[cell_of_[j] + 1];
+    }
+    for (int c = 0; c < kCells * kCells; ++c) start_[c + 1] += start_[c];
+    index_.resize(blobs.size() - wide_.size());
+    next_.assign(start_.begin(), start_.end() - 1);
+    for (std::size_t j = 0; j < blobs.size(); ++j)
+      if (cell_of_[j] >= 0) index_[next_[cell_of_[j]]++] = static_cast<int>(j);
+  }
+  // 0.25 times the largest small blob's angular radius, squared: its term in a pair's sigma.
+  double largest_term() const { return largest_term_; }
+  // Calls f(j) for every wide blob and every small one whose ray's x and y lie within `reach`
+  // of `ray`'s (and some more, of the same cells).
+  template <class F>
+  void visit(const Eigen::Vector3d& ray, double reach, F&& f) const {
+    for (const int j : wide_) f(j);
+    if (index_.empty()) return;
+    const double r = reach + 1e-9;  // a ray on a cell's edge is in both
+    const int x0 = bin(ray.x() - r), x1 = bin(ray.x() + r);
+    const int y0 = bin(ray.y() - r), y1 = bin(ray.y() + r);
+    for (int y = y0; y <= y1; ++y) {
+      const int row = y * kCells;
+      for (int k = start_[row + x0]; k < start_[row + x1 + 1]; ++k) f(index_[k]);
+    }
+  }
+
+ private:
+  static constexpr int kCells = 24;  // over [-1, 1]: cells of 0.083
+  static int bin(double v) {
+    const double c = std::floor((v + 1.0) * (0.5 * kCells));
+    return static_cast<int>(std::clamp(std::isfinite(c) ? c : 0.0, 0.0, kCells - 1.0));
+  }
+  std::vector<int> wide_, start_, next_, index_, cell_of_;
+  double largest_term_ = 0;
+};
+
 // One pose scored against the blobs.
 struct Evaluation {
   double cost = std::numeric_limits<double>::infinity();
@@ -121,13 +185,39 @@ struct GlobalLocalizer::Impl {
     int columns = 0, rows = 0;
     std::vector<int> start;  // per cell, into `lamps`; one more at the end
     std::vector<int> lamps;  // lamp indices, cell by cell, each cell in the map's order
-  } grid;
+    // Calls f(i) for the lamps i of the cells that meet the square of side 2 r around p (the
+    // caller tests the distance).
+    template <class F>
+    void visit(const Vector2d& p, double r, F&& f) const {
+      if (lamps.empty()) return;
+      const Vector2d lo = (p - Vector2d(r, r) - origin) / cell;
+      const Vector2d hi = (p + Vector2d(r, r) - origin) / cell;
+      if (!(hi.x() >= 0 && hi.y() >= 0 && lo.x() < columns && lo.y() < rows)) return;
+      auto at = [](double v, int n) { return static_cast<int>(std::clamp(v, 0.0, n - 1.0)); };
+      const int x0 = at(lo.x(), columns), x1 = at(hi.x(), columns);
+      const int y0 = at(lo.y(), rows), y1 = at(hi.y(), rows);
+      for (int y = y0; y <= y1; ++y)
+        for (int k = start[y * columns + x0]; k < start[y * columns + x1 + 1]; ++k) f(lamps[k]);
+    }
+  };
+  LampGrid grid;  // cells of half the view radius
+  // Cells of a metre, for the screening's "is there a lamp of this class within r of here?".
+  LampGrid fine_grid;
+  LampGrid make_grid(double cell) const;
   std::vector<Vector2d> lamp_xy;                   // per lamp
   std::vector<double> lamp_cos_yaw, lamp_sin_yaw;  // per lamp
   void index_lamps();
   void grid_lamps();
-  // The lamps within `radius` of the pose (default: view_radius), in the map's order.
-  std::vector<int> lamps_in_view(const Pose2& pose, double radius = 0) const;
+  // Whether a lamp of class `cl` lies within r of p (the map's distance test).
+  bool lamp_of_class_within(const Vector2d& p, double r, int cl) const {
+    bool found = false;
+    fine_grid.visit(p, r, [&](int i) {
+      if (!found && class_of[i] == cl && (lamp_xy[i] - p).squaredNorm() <= r * r) found = true;
+    });
+    return found;
+  }
+  // The lamps within `radius` of the pose (0: view_radius), in the map's order, into `out`.
+  void lamps_in_view(const Pose2& pose, double radius, std::vector<int>& out) const;
 
   Impl(const graph::TopologicalMap& m, const CameraDescription& camera,
        const GlobalLocalizerOptions& opt);

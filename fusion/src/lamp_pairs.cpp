@@ -253,8 +253,7 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
         const Vector2d w =
             pose.translation() + Vector2d(c * b.x() - s * b.y(), s * b.x() + c * b.y());
         const double r = 3 * sg + 0.3;
-        for (const graph::Lamp* l : map->lamps_within(w, r))
-          if (class_of[lamp_index.at(l)] == int(cl)) on_lamp = true;
+        on_lamp = lamp_of_class_within(w, r, int(cl));
       }
       if (!on_lamp) ++misses;
     }
