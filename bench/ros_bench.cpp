@@ -4,13 +4,17 @@
 // joint states. The node times each image from its arrival (handed over by DDS) to the pose it
 // publishes after it (decoding included); the player counts what it sent, the node what it
 // received. The iteration time is the ceiling camera's p99; the rest are counters. Run twice:
-// the images as PNG (a 1024 x 1024 omni frame takes 11 ms to decode alone), and as most camera
-// drivers compress them (JPEG, quality 90; argument 90).
+// the images as PNG (a 1024 x 1024 omni frame takes 11 ms to decode alone), as most camera
+// drivers compress them (JPEG, quality 90; argument 90), and as raw grey frames
+// (sensor_msgs/msg/Image, mono8, on .../image_raw; argument -1). Second argument 1: the node is
+// told where the robot starts (--initial-pose), as a robot's launch file or /initialpose would;
+// 0: it finds the start from the omni camera, enumerating the places its first images fit.
 //   Targets: image in to pose out at most 5 ms (p99); no message lost.
 
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -49,19 +53,28 @@ void BM_NodeImageToPose(benchmark::State& state) {
   const double messages = static_cast<double>(
       mission.wheels.size() + mission.ceiling_images.size() + mission.omni_images.size());
   const std::string domain = std::to_string(1 + ::getpid() % 230);
+  char start[96] = "";
+  if (state.range(1) == 1)
+    std::snprintf(start, sizeof start, " --initial-pose %.17g,%.17g,%.17g", scenario.start.x(),
+                  scenario.start.y(), scenario.start.yaw());
+  const std::string start_pose = start;
   for (auto _ : state) {
     fs::remove(dir + "/stats.json");
     const std::string node = std::string(LAMPNAV_BINARY) + " node --robot " + src +
                              "/maps/robots/pioneer.json --map " + src +
-                             "/maps/office_floor.geojson --domain " + domain +
+                             "/maps/office_floor.geojson --domain " + domain + start_pose +
+                             (state.range(0) < 0 ? " --ceiling-topic /ceiling_camera/image_raw"
+                                                   " --omni-topic /omni_camera/image_raw"
+                                                 : "") +
                              " --joint-states-topic /joint_states --wheel-radius 0.1"
                              " --idle-exit 3 --quiet --stats " +
                              dir + "/stats.json > " + dir + "/node.out 2>&1 &";
-    const std::string player =
-        std::string(LAMPNAV_LOG_PLAYER) + " " + log + " --domain " + domain +
-        " --rate 3.05 --wheel-radius 0.1" +
-        (state.range(0) > 0 ? " --jpeg " + std::to_string(state.range(0)) : std::string()) + " > " +
-        dir + "/player.out 2>&1";
+    const std::string player = std::string(LAMPNAV_LOG_PLAYER) + " " + log + " --domain " + domain +
+                               " --rate 3.05 --wheel-radius 0.1" +
+                               (state.range(0) > 0   ? " --jpeg " + std::to_string(state.range(0))
+                                : state.range(0) < 0 ? std::string(" --raw")
+                                                     : std::string()) +
+                               " > " + dir + "/player.out 2>&1";
     if (std::system(node.c_str()) != 0 || std::system(player.c_str()) != 0) {
       state.SkipWithError(("the node or the player failed: " + slurp(dir + "/player.out")).c_str());
       break;
@@ -89,8 +102,11 @@ void BM_NodeImageToPose(benchmark::State& state) {
   fs::remove_all(dir);
 }
 BENCHMARK(BM_NodeImageToPose)
-    ->Arg(0)
-    ->Arg(90)
+    ->Args({0, 0})
+    ->Args({90, 0})
+    ->Args({90, 1})
+    ->Args({-1, 0})
+    ->Args({-1, 1})
     ->Iterations(1)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);

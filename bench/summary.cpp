@@ -361,7 +361,11 @@ int main(int argc, char** argv) {
     add_value(drive + ", lamp height max", counter(bench, "height_max_cm", 1), "", std::nullopt,
               3.0, std::nullopt, "cm");
   }
-  for (const auto& [arg, format] : {std::pair{"0", "PNG"}, {"90", "JPEG 90"}}) {
+  for (const auto& [arg, format] : {std::pair{"0/0", "PNG"},
+                                    {"90/0", "JPEG 90"},
+                                    {"90/1", "JPEG 90, start pose given"},
+                                    {"-1/0", "raw mono8"},
+                                    {"-1/1", "raw mono8, start pose given"}}) {
     const std::string bench = std::string("BM_NodeImageToPose/") + arg;
     for (const char* camera : {"ceiling", "omni"})
       for (const char* q : {"p50", "p99"})

@@ -1,10 +1,11 @@
 // lampnav_log_player: plays a recorded mission over DDS as a ROS 2 robot's drivers would (the
-// wheel joints as sensor_msgs/msg/JointState, the cameras as sensor_msgs/msg/CompressedImage,
+// wheel joints as sensor_msgs/msg/JointState, the cameras as sensor_msgs/msg/CompressedImage
+// (or, with --raw, as sensor_msgs/msg/Image in mono8 on .../image_raw),
 // header stamps the capture times), at the pace of the log's arrival times (times --rate), and
 // writes what the node publishes on /lampnav/pose. For the node's tests and benchmark.
 //
 //   lampnav_log_player LOG.mcap --domain D [--rate R] [--wheel-radius M] [--poses OUT]
-//                      [--wait-s S] [--loops N] [--jpeg QUALITY]
+//                      [--wait-s S] [--loops N] [--jpeg QUALITY | --raw]
 // Prints one line of counts; exit 0, 1 when no node answered, 2 for bad arguments.
 
 #include <atomic>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "lampnav/core/error.hpp"
+#include "lampnav/core/image.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/io/ros2_messages.hpp"
 #include "lampnav/ros/participant.hpp"
@@ -47,10 +49,31 @@ int main(int argc, char** argv) {
   ros::Participant p(o.domain, po);
   ros::Writer& joints =
       p.writer("/joint_states", "sensor_msgs/msg/JointState", ros::Qos::sensor_data);
-  ros::Writer& ceiling = p.writer("/ceiling_camera/image_raw/compressed",
-                                  "sensor_msgs/msg/CompressedImage", ros::Qos::sensor_data);
-  ros::Writer& omni = p.writer("/omni_camera/image_raw/compressed",
-                               "sensor_msgs/msg/CompressedImage", ros::Qos::sensor_data);
+  const std::string suffix = o.raw ? "" : "/compressed";
+  const std::string image_type =
+      o.raw ? "sensor_msgs/msg/Image" : "sensor_msgs/msg/CompressedImage";
+  ros::Writer& ceiling =
+      p.writer("/ceiling_camera/image_raw" + suffix, image_type, ros::Qos::sensor_data);
+  ros::Writer& omni =
+      p.writer("/omni_camera/image_raw" + suffix, image_type, ros::Qos::sensor_data);
+  // Raw frames are decoded before playing, as a camera driver hands them over.
+  std::vector<Image8> raw_ceiling, raw_omni;
+  if (o.raw) {
+    for (const auto& f : log.ceiling_images)
+      raw_ceiling.push_back(io::decode_image(f.value.data, o.log));
+    for (const auto& f : log.omni_images) raw_omni.push_back(io::decode_image(f.value.data, o.log));
+  }
+  const auto image_message = [&](Stamp stamp, const char* frame, const Image8& image) {
+    io::CdrWriter w;
+    w.header(to_nanoseconds(stamp), frame)
+        .u32(static_cast<std::uint32_t>(image.height))
+        .u32(static_cast<std::uint32_t>(image.width))
+        .string("mono8")
+        .u8(0)
+        .u32(static_cast<std::uint32_t>(image.width));
+    w.bytes(std::string(image.pixels.begin(), image.pixels.end()));
+    return w.take();
+  };
   std::mutex m;
   std::vector<std::string> poses;
   std::atomic<long> received{0};
@@ -97,10 +120,12 @@ int main(int argc, char** argv) {
             {w.left / o.wheel_radius, w.right / o.wheel_radius}));
       } else {
         const auto& f = (kind == 1 ? log.ceiling_images : log.omni_images)[it.index].value;
+        const char* frame = kind == 1 ? "ceiling_camera" : "omni_camera";
         ok = (kind == 1 ? ceiling : omni)
-                 .write(io::ros2::compressed_image_message(
-                     f.stamp + shift, kind == 1 ? "ceiling_camera" : "omni_camera", f.format,
-                     f.data));
+                 .write(o.raw ? image_message(f.stamp + shift, frame,
+                                              (kind == 1 ? raw_ceiling : raw_omni)[it.index])
+                              : io::ros2::compressed_image_message(f.stamp + shift, frame, f.format,
+                                                                   f.data));
       }
       if (ok)
         ++sent[kind];

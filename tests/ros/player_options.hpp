@@ -14,6 +14,7 @@ struct PlayerOptions {
   std::string log, poses;
   int domain = 0, loops = 1;
   int jpeg_quality = 0;  // > 0: images sent as JPEG of this quality (decoded and encoded first)
+  bool raw = false;      // images sent as sensor_msgs/msg/Image (mono8), decoded first
   double rate = 1, wheel_radius = 0.1, wait_s = 20, linger_s = 3;
 };
 
@@ -44,6 +45,8 @@ inline PlayerOptions parse_player_options(int argc, char** argv) {
       o.loops = static_cast<int>(number(k));
     else if (a == "--jpeg")
       o.jpeg_quality = static_cast<int>(number(k));
+    else if (a == "--raw")
+      o.raw = true;
     else if (a == "--poses" && k + 1 < argc)
       o.poses = argv[++k];
     else if (!a.empty() && a[0] != '-' && o.log.empty())
@@ -53,6 +56,7 @@ inline PlayerOptions parse_player_options(int argc, char** argv) {
   }
   if (o.log.empty()) throw std::invalid_argument("no log given");
   if (o.jpeg_quality > 100) throw std::invalid_argument("--jpeg: quality 1 to 100");
+  if (o.raw && o.jpeg_quality > 0) throw std::invalid_argument("--raw or --jpeg, not both");
   if (!(o.rate > 0) || !(o.wheel_radius > 0) || o.loops < 1)
     throw std::invalid_argument("--rate, --wheel-radius and --loops must be positive");
   return o;

@@ -63,6 +63,13 @@ Json pose(const Pose2& p) {
   return {{"position", point(p.x(), p.y())}, {"orientation", quaternion(p.yaw())}};
 }
 
+// sensor_msgs/msg/Image, 3 rows of 4 mono8 pixels in rows of 6 bytes, as a driver writes it.
+std::string raw_mono8(Stamp t, const std::string& pixels) {
+  io::CdrWriter w;
+  w.header(to_nanoseconds(t), "ceiling_camera").u32(3).u32(4).string("mono8").u8(0).u32(6);
+  return w.bytes(pixels).take();
+}
+
 TEST(RosWire, EveryMessageIsByteForByteWhatRos2ToolingWrites) {
   const std::string interop = test::source_path("tests/interop");
   ASSERT_TRUE(fs::exists(interop + "/node_modules/@foxglove/rosmsg2-serialization"))
@@ -106,6 +113,19 @@ TEST(RosWire, EveryMessageIsByteForByteWhatRos2ToolingWrites) {
   add("sensor_msgs/msg/CompressedImage",
       {{"header", header(t, "ceiling_camera")}, {"format", "png"}, {"data_hex", hex(png)}},
       io::ros2::compressed_image_message(t, "ceiling_camera", "png", png));
+  // What a camera driver writes (the node reads it; lampnav itself never writes one): 3 x 4
+  // mono8, each row padded to 6 bytes.
+  const std::string pixels(
+      "\x01\x02\x03\x04\xAA\xAA\x05\x06\x07\x08\xAA\xAA\x09\x0A\x0B\x0C\xAA\xAA", 18);
+  add("sensor_msgs/msg/Image",
+      {{"header", header(t, "ceiling_camera")},
+       {"height", 3},
+       {"width", 4},
+       {"encoding", "mono8"},
+       {"is_bigendian", 0},
+       {"step", 6},
+       {"data_hex", hex(pixels)}},
+      raw_mono8(t, pixels));
   Json zeros36 = Json::array();
   for (int k = 0; k < 36; ++k) zeros36.push_back(0.0);
   const Json zero3 = {{"x", 0.0}, {"y", 0.0}, {"z", 0.0}};
@@ -148,6 +168,14 @@ TEST(RosWire, WhatTheNodeWritesItsDecodersRead) {
   EXPECT_EQ(j.left, 1.5);
   EXPECT_EQ(j.right, 2.5);
   EXPECT_EQ(io::ros2::string_data(io::ros2::string_message("go")), "go");
+  const io::ros2::GreyImage g = io::ros2::raw_image_grey(raw_mono8(
+      t,
+      std::string("\x01\x02\x03\x04\xAA\xAA\x05\x06\x07\x08\xAA\xAA\x09\x0A\x0B\x0C\xAA\xAA", 18)));
+  EXPECT_EQ(g.stamp, t);
+  ASSERT_EQ(g.image.width, 4);
+  ASSERT_EQ(g.image.height, 3);
+  EXPECT_EQ(g.image.at(0, 0), 1);
+  EXPECT_EQ(g.image.at(3, 2), 12);  // the padding of each row left out
   // Cut short anywhere, a message is refused with the field, never read past its end.
   const std::string full = io::ros2::joint_state_message(t, {"l_wheel", "r_wheel"}, {1, 2});
   for (std::size_t n = 0; n < full.size(); ++n)
