@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "flat_grid.hpp"
 #include "lampnav/fusion/global_localizer.hpp"
 #include "lampnav/fusion/merit.hpp"
 #include "lampnav/vision/camera_models.hpp"
@@ -31,14 +32,14 @@ struct BlobRay {
 };
 
 // The blobs of one image by where their rays point, to find those within a chord of a ray
-// without trying every blob (a 1,000-node building's view holds 80 blobs and 100 lamps). Rays
+// without trying every blob (a 1,000-node building's view holds about 77 blobs and 95 lamps). Rays
 // are binned by their x and y, which no chord is shorter than. Blobs of more than kSmall rad
 // (a lamp nearly overhead) are few and wide: they are tried for every ray, so that a query's
 // reach needs to allow only for the largest small blob.
 class RayGrid {
  public:
   static constexpr double kSmall = 0.06;
-  // Up to kFew blobs are all tried for every ray: binning them would cost more than it saves.
+  // Up to kFew blobs are all tried for every ray, unbinned: the screening's cone holds about 5.
   static constexpr std::size_t kFew = 12;
   // Bins the blobs (the storage of an earlier build kept).
   void build(const std::vector<BlobRay>& blobs) {
@@ -179,31 +180,9 @@ struct GlobalLocalizer::Impl {
   std::unordered_map<const graph::Lamp*, int> lamp_index;
   double view_radius = 0;
   double max_height = 0;  // of a lamp above the camera
-  struct LampGrid {
-    Vector2d origin = Vector2d::Zero();
-    double cell = 1;
-    int columns = 0, rows = 0;
-    std::vector<int> start;  // per cell, into `lamps`; one more at the end
-    std::vector<int> lamps;  // lamp indices, cell by cell, each cell in the map's order
-    // Calls f(i) for the lamps i of the cells that meet the square of side 2 r around p (the
-    // caller tests the distance).
-    template <class F>
-    void visit(const Vector2d& p, double r, F&& f) const {
-      if (lamps.empty()) return;
-      const Vector2d lo = (p - Vector2d(r, r) - origin) / cell;
-      const Vector2d hi = (p + Vector2d(r, r) - origin) / cell;
-      if (!(hi.x() >= 0 && hi.y() >= 0 && lo.x() < columns && lo.y() < rows)) return;
-      auto at = [](double v, int n) { return static_cast<int>(std::clamp(v, 0.0, n - 1.0)); };
-      const int x0 = at(lo.x(), columns), x1 = at(hi.x(), columns);
-      const int y0 = at(lo.y(), rows), y1 = at(hi.y(), rows);
-      for (int y = y0; y <= y1; ++y)
-        for (int k = start[y * columns + x0]; k < start[y * columns + x1 + 1]; ++k) f(lamps[k]);
-    }
-  };
-  LampGrid grid;  // cells of half the view radius
+  detail::FlatGrid grid;  // cells of half the view radius
   // Cells of a metre, for the screening's "is there a lamp of this class within r of here?".
-  LampGrid fine_grid;
-  LampGrid make_grid(double cell) const;
+  detail::FlatGrid fine_grid;
   std::vector<Vector2d> lamp_xy;                   // per lamp
   std::vector<double> lamp_cos_yaw, lamp_sin_yaw;  // per lamp
   void index_lamps();

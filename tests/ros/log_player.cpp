@@ -19,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include "cdr_writer.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/core/image.hpp"
 #include "lampnav/io/mission_log.hpp"
@@ -63,16 +64,11 @@ int main(int argc, char** argv) {
       raw_ceiling.push_back(io::decode_image(f.value.data, o.log));
     for (const auto& f : log.omni_images) raw_omni.push_back(io::decode_image(f.value.data, o.log));
   }
-  const auto image_message = [&](Stamp stamp, const char* frame, const Image8& image) {
-    io::CdrWriter w;
-    w.header(to_nanoseconds(stamp), frame)
-        .u32(static_cast<std::uint32_t>(image.height))
-        .u32(static_cast<std::uint32_t>(image.width))
-        .string("mono8")
-        .u8(0)
-        .u32(static_cast<std::uint32_t>(image.width));
-    w.bytes(std::string(image.pixels.begin(), image.pixels.end()));
-    return w.take();
+  const auto image_message = [](Stamp stamp, const char* frame, const Image8& image) {
+    const auto width = static_cast<std::uint32_t>(image.width);
+    return test::mono8_image_cdr(to_nanoseconds(stamp), frame, width,
+                                 static_cast<std::uint32_t>(image.height), width,
+                                 std::string(image.pixels.begin(), image.pixels.end()));
   };
   std::mutex m;
   std::vector<std::string> poses;

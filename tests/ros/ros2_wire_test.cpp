@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cdr.hpp"
+#include "cdr_writer.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/io/ros2_messages.hpp"
 #include "lampnav/ros/participant.hpp"
@@ -64,10 +65,10 @@ Json pose(const Pose2& p) {
 }
 
 // sensor_msgs/msg/Image, 3 rows of 4 mono8 pixels in rows of 6 bytes, as a driver writes it.
-std::string raw_mono8(Stamp t, const std::string& pixels) {
-  io::CdrWriter w;
-  w.header(to_nanoseconds(t), "ceiling_camera").u32(3).u32(4).string("mono8").u8(0).u32(6);
-  return w.bytes(pixels).take();
+const std::string kMono8Rows(
+    "\x01\x02\x03\x04\xAA\xAA\x05\x06\x07\x08\xAA\xAA\x09\x0A\x0B\x0C\xAA\xAA", 18);
+std::string raw_mono8(Stamp t) {
+  return test::mono8_image_cdr(to_nanoseconds(t), "ceiling_camera", 4, 3, 6, kMono8Rows);
 }
 
 TEST(RosWire, EveryMessageIsByteForByteWhatRos2ToolingWrites) {
@@ -115,8 +116,6 @@ TEST(RosWire, EveryMessageIsByteForByteWhatRos2ToolingWrites) {
       io::ros2::compressed_image_message(t, "ceiling_camera", "png", png));
   // What a camera driver writes (the node reads it; lampnav itself never writes one): 3 x 4
   // mono8, each row padded to 6 bytes.
-  const std::string pixels(
-      "\x01\x02\x03\x04\xAA\xAA\x05\x06\x07\x08\xAA\xAA\x09\x0A\x0B\x0C\xAA\xAA", 18);
   add("sensor_msgs/msg/Image",
       {{"header", header(t, "ceiling_camera")},
        {"height", 3},
@@ -124,8 +123,8 @@ TEST(RosWire, EveryMessageIsByteForByteWhatRos2ToolingWrites) {
        {"encoding", "mono8"},
        {"is_bigendian", 0},
        {"step", 6},
-       {"data_hex", hex(pixels)}},
-      raw_mono8(t, pixels));
+       {"data_hex", hex(kMono8Rows)}},
+      raw_mono8(t));
   Json zeros36 = Json::array();
   for (int k = 0; k < 36; ++k) zeros36.push_back(0.0);
   const Json zero3 = {{"x", 0.0}, {"y", 0.0}, {"z", 0.0}};
@@ -168,9 +167,7 @@ TEST(RosWire, WhatTheNodeWritesItsDecodersRead) {
   EXPECT_EQ(j.left, 1.5);
   EXPECT_EQ(j.right, 2.5);
   EXPECT_EQ(io::ros2::string_data(io::ros2::string_message("go")), "go");
-  const io::ros2::GreyImage g = io::ros2::raw_image_grey(raw_mono8(
-      t,
-      std::string("\x01\x02\x03\x04\xAA\xAA\x05\x06\x07\x08\xAA\xAA\x09\x0A\x0B\x0C\xAA\xAA", 18)));
+  const io::ros2::GreyImage g = io::ros2::raw_image_grey(raw_mono8(t));
   EXPECT_EQ(g.stamp, t);
   ASSERT_EQ(g.image.width, 4);
   ASSERT_EQ(g.image.height, 3);

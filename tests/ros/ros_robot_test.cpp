@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "cdr.hpp"
+#include "cdr_writer.hpp"
 #include "lampnav/io/ros2_messages.hpp"
 #include "lampnav/ros/ros_robot.hpp"
 #include "lampnav_test.hpp"
@@ -69,16 +70,10 @@ TEST(RosRobot, TakesInputsRefusesDamagedOnesAndPublishes) {
   const std::string good = io::ros2::odometry_message(at(2), "odom", "base_link", Pose2(1, 0, 0));
   ASSERT_TRUE(odom.write(good.substr(0, 60)));  // cut short
   ASSERT_TRUE(odom.write(good));
-  io::CdrWriter image;
-  image.header(to_nanoseconds(at(1.5)), "ceiling_camera")
-      .u32(3)
-      .u32(4)
-      .string("mono8")
-      .u8(0)
-      .u32(6);
-  image.bytes(
-      std::string("\x01\x02\x03\x04\xAA\xAA\x05\x06\x07\x08\xAA\xAA\x09\x0A\x0B\x0C\xAA\xAA", 18));
-  ASSERT_TRUE(camera.write(image.take()));
+  ASSERT_TRUE(camera.write(test::mono8_image_cdr(
+      to_nanoseconds(at(1.5)), "ceiling_camera", 4, 3, 6,
+      std::string("\x01\x02\x03\x04\xAA\xAA\x05\x06\x07\x08\xAA\xAA\x09\x0A\x0B\x0C\xAA\xAA",
+                  18))));
   ASSERT_TRUE(command.write(io::ros2::string_message("follow the corridor")));
 
   std::vector<WheelInput> wheels;
