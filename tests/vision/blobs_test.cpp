@@ -94,5 +94,31 @@ TEST(BlobLabeller, SameBlobsAsOpenCvsConnectedComponents) {
   EXPECT_GT(cases, 300);
 }
 
+// next_column against its definition, byte by byte: every start, both kinds, rows of 0 to 70
+// pixels (so every tail after the 16-pixel blocks), transitions anywhere.
+TEST(BlobLabeller, NextColumnIsTheFirstPixelOfTheKindAsked) {
+  std::mt19937 rng(3);
+  int checked = 0;
+  for (int w = 0; w <= 70; ++w) {
+    for (int trial = 0; trial < 20; ++trial) {
+      std::vector<std::uint8_t> row(static_cast<std::size_t>(w) + 1);
+      const int bright_every = 1 + static_cast<int>(rng() % 40);
+      for (auto& p : row)
+        p = rng() % bright_every == 0 ? static_cast<std::uint8_t>(128 + rng() % 128)
+                                      : static_cast<std::uint8_t>(rng() % 128);
+      for (int u = 0; u <= w; ++u) {
+        for (const bool bright : {true, false}) {
+          int expected = u;
+          while (expected < w && (row[expected] >= 128) != bright) ++expected;
+          ASSERT_EQ(next_column(row.data(), u, w, 128, bright), expected)
+              << "w " << w << ", u " << u << (bright ? ", bright" : ", dark");
+          ++checked;
+        }
+      }
+    }
+  }
+  EXPECT_GT(checked, 100000);
+}
+
 }  // namespace
 }  // namespace lampnav::vision::detail

@@ -279,6 +279,97 @@ TEST(LampDetector, CompletesLampsCutByTheBorder) {
             << " lamps more than 70% in view, max centre error " << s.max_completed_px << " px\n";
 }
 
+// A tracker reads the image's side columns border_chord_px() / 3 pixels apart (LampTracker): every
+// lamp entering there, one or two of its corners in view, must leave at least half of that stretch
+// bright in the column (the rest is slack for the blurred ends of the chord, and for a lamp that
+// nearly reaches an image corner, where the top or bottom row does not see it yet). Random poses,
+// every heading, and the camera at 640x480 too.
+void expect_side_columns_cut_lamps_by_the_border_chord(const CameraDescription& camera,
+                                                       int frames) {
+  const World w;
+  const sim::CeilingRenderer renderer(camera, {});
+  LampDetector detector(camera, office_prior());
+  const double chord = detector.border_chord_px();
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> uni(0, 1);
+  std::normal_distribution<double> bump(0, 0.5 * M_PI / 180);
+  std::vector<const graph::Lamp*> all;
+  for (const auto* l : w.map.lamps_within(Vector2d::Zero(), 1e6))
+    if (l->shape == graph::LampShape::rectangle) all.push_back(l);
+  int cut[3] = {0, 0, 0};  // lamps cut by a side column with 1, 2 and 3 corners in view
+  double least = 1e9;      // the fewest column pixels of a lamp entering, over border_chord_px
+  for (int f = 0; f < frames; ++f) {
+    // The robot within 1.6 m of a lamp, any heading: lamps come in view at every angle.
+    const graph::Lamp& near = *all[f % all.size()];
+    const double a = uni(rng) * 2 * M_PI, r = 0.6 + 1.0 * uni(rng);
+    const Pose2 pose(near.xyz.head<2>() + r * Vector2d(std::cos(a), std::sin(a)),
+                     uni(rng) * 2 * M_PI);
+    const sim::CameraTilt tilt{bump(rng), bump(rng)};
+    const auto lamps = w.map.lamps_within(pose.translation(), 5.0);
+    const Image8 img = renderer.render(pose, tilt, lamps, rng);
+    for (const LampDetection& d : detector.detect(img).lamps) {
+      for (const int u : {0, camera.width - 1}) {
+        if (d.bbox[0] > u || d.bbox[2] < u) continue;
+        // A lamp cut by the top or bottom row too is seen there: those rows are read whole.
+        if (d.bbox[1] == 0 || d.bbox[3] == camera.height - 1) continue;
+        int bright = 0;
+        for (int v = d.bbox[1]; v <= d.bbox[3]; ++v)
+          bright += img.at(u, v) >= detector.options().threshold ? 1 : 0;
+        // The lamp under the blob, and how many of its face's corners are in view.
+        const graph::Lamp* lamp = nullptr;
+        double best = 1e9;
+        for (const auto* l : lamps) {
+          const auto p = renderer.project(pose, tilt, l->xyz);
+          if (p && (*p - d.centre_px).norm() < best) best = (*p - d.centre_px).norm(), lamp = l;
+        }
+        ASSERT_NE(lamp, nullptr);
+        if (lamp->shape != graph::LampShape::rectangle) continue;
+        const Vector2d e(std::cos(lamp->yaw), std::sin(lamp->yaw)), n(-e.y(), e.x());
+        int in = 0;
+        for (double s : {-0.5, 0.5}) {
+          for (double q : {-0.5, 0.5}) {
+            const Vector2d c = lamp->xyz.head<2>() + s * lamp->length * e + q * lamp->width * n;
+            const auto p = renderer.project(pose, tilt, Vector3d(c.x(), c.y(), lamp->xyz.z()));
+            in += p && p->x() >= 0 && p->y() >= 0 && p->x() <= camera.width - 1 &&
+                          p->y() <= camera.height - 1
+                      ? 1
+                      : 0;
+          }
+        }
+        if (in < 1 || in > 3) continue;
+        ++cut[in - 1];
+        // Three corners in view: the lamp came in across two sides first (a short chord now).
+        if (in == 3) continue;
+        least = std::min(least, bright / chord);
+        EXPECT_GE(bright, chord / 2)
+            << "frame " << f << ": " << lamp->id.value << " with " << in
+            << " corners in view covers " << bright << " px of column " << u;
+      }
+    }
+  }
+  std::cout << camera.width << "x" << camera.height << ": border chord " << chord
+            << " px; lamps cut by a side column with 1, 2, 3 corners in view: " << cut[0] << ", "
+            << cut[1] << ", " << cut[2] << "; the fewest column pixels of one entering " << least
+            << " chords\n";
+  EXPECT_GT(cut[1], 100);
+  // The bound is tight enough to be worth reading columns sparsely.
+  EXPECT_GT(chord, camera.width / 20.0);
+}
+
+TEST(LampDetector, LampsEnteringByASideCoverTheBorderChordOfItsColumn) {
+  const World w;
+  expect_side_columns_cut_lamps_by_the_border_chord(w.camera(), 1000);
+  CameraDescription c = w.camera();
+  const double scale = 640.0 / c.width;
+  c.pinhole.fx *= scale;
+  c.pinhole.fy *= scale;
+  c.width = 640;
+  c.height = 480;
+  c.pinhole.cx = 0.5 * (c.width - 1);
+  c.pinhole.cy = 0.5 * (c.height - 1);
+  expect_side_columns_cut_lamps_by_the_border_chord(c, 600);
+}
+
 TEST(LampDetector, NoLampInNoiseOrOnBrightFringes) {
   const World w;
   sim::CeilingRenderOptions bright;

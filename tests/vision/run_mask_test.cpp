@@ -105,5 +105,43 @@ TEST(RunOpening, SamePixelsAsTheOpeningByDefinition) {
   EXPECT_GT(changed, 150);  // the opening did something in most cases
 }
 
+// Lamp-like masks: one ragged span per row (a slanted bar, its ends rough), some rows with a
+// fringe beside it or a gap in it, some rows empty. Most windows of 2r+1 rows then hold one span
+// a row, which the opening joins directly; r up to 5, the options' largest.
+TEST(RunOpening, SamePixelsAsTheDefinitionOnLampLikeMasks) {
+  std::mt19937 rng(11);
+  RunOpening opening;
+  RunMask out;
+  int cases = 0, single_rows = 0, rows = 0;
+  for (int r = 1; r <= 5; ++r) {
+    for (int trial = 0; trial < 30; ++trial) {
+      const int w = 20 + static_cast<int>(rng() % 60), h = 10 + static_cast<int>(rng() % 40);
+      Bytes m(static_cast<std::size_t>(w) * h, 0);
+      const double slope = (static_cast<int>(rng() % 200) - 100) / 100.0;
+      const int half = 3 + static_cast<int>(rng() % (w / 3));
+      for (int y = 1; y < h - 1; ++y) {
+        if (rng() % 20 == 0) continue;  // an empty row
+        const int mid = w / 2 + static_cast<int>(slope * (y - h / 2));
+        const int a = std::max(0, mid - half + static_cast<int>(rng() % 3) - 1);
+        const int b = std::min(w - 1, mid + half + static_cast<int>(rng() % 3) - 1);
+        for (int x = a; x <= b; ++x) m[static_cast<std::size_t>(y) * w + x] = 1;
+        if (rng() % 10 == 0 && b + 3 < w) m[static_cast<std::size_t>(y) * w + b + 2] = 1;
+        if (rng() % 10 == 0 && b - a > 4) m[static_cast<std::size_t>(y) * w + (a + b) / 2] = 0;
+      }
+      const RunMask in = runs_of(m, w, h);
+      for (int y = 0; y < h; ++y) {
+        ++rows;
+        single_rows += in.row_end(y) - in.row_begin(y) == 1 ? 1 : 0;
+      }
+      opening.open(in, r, out);
+      ASSERT_EQ(bytes_of(out), opened_by_definition(m, w, h, r))
+          << "r " << r << ", " << w << " x " << h << ", trial " << trial;
+      ++cases;
+    }
+  }
+  EXPECT_EQ(cases, 150);
+  EXPECT_GT(single_rows, rows * 3 / 5);
+}
+
 }  // namespace
 }  // namespace lampnav::vision::detail

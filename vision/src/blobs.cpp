@@ -19,7 +19,15 @@ int next_column(const std::uint8_t* row, int u, int w, std::uint8_t t, bool brig
   for (; u + 16 <= w; u += 16) {
     const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + u));
     // max(x, t) == x exactly where x >= t (unsigned).
-    if (_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_max_epu8(x, threshold), x)) != passed) break;
+    const int found = _mm_movemask_epi8(_mm_cmpeq_epi8(_mm_max_epu8(x, threshold), x)) ^ passed;
+    if (found != 0) return u + __builtin_ctz(static_cast<unsigned>(found));  // its first pixel
+  }
+  if (u < w && w >= 16) {
+    // The last block, read from w - 16: the pixels before u are shifted out.
+    const __m128i x = _mm_loadu_si128(reinterpret_cast<const __m128i*>(row + w - 16));
+    const int found = (_mm_movemask_epi8(_mm_cmpeq_epi8(_mm_max_epu8(x, threshold), x)) ^ passed) >>
+                      (u - (w - 16));
+    return found != 0 ? u + __builtin_ctz(static_cast<unsigned>(found)) : w;
   }
 #else
   for (; u + 8 <= w; u += 8) {
@@ -57,8 +65,19 @@ void BlobLabeller::label(const ImageView& g, std::uint8_t t, const PixelBox& req
   const int du = box_.u0, dv = box_.v0;  // box -> image coordinates
   width_ = w;
   int prev_begin = 0, prev_end = 0;
+  // The box's rows are asked of memory a few rows ahead of the scan: a frame just captured is
+  // seldom in the cache, and a window's short rows give the hardware's prefetcher little to go on.
+  const std::size_t stride = g.row_stride();
+  auto prefetch_row = [&](int v) {
+    const std::uint8_t* p = g.data + static_cast<std::size_t>(v + dv) * stride + du;
+    for (int k = 0; k < w; k += 64) __builtin_prefetch(p + k);
+    __builtin_prefetch(p + w - 1);
+  };
+  constexpr int kRowsAhead = 6;
+  for (int v = 0; v < std::min(kRowsAhead, h); ++v) prefetch_row(v);
   for (int v = 0; v < h; ++v) {
-    const std::uint8_t* in = g.data + static_cast<std::size_t>(v + dv) * g.row_stride() + du;
+    if (v + kRowsAhead < h) prefetch_row(v + kRowsAhead);
+    const std::uint8_t* in = g.data + static_cast<std::size_t>(v + dv) * stride + du;
     const int cur_begin = static_cast<int>(runs_.size());
     int u = 0;
     while (u < w) {

@@ -47,50 +47,70 @@ ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Ve
   ShapeFit fit;
   use.assign(pts.size(), 1);
   double rms = 0;
+  // Points are dropped once the fit has settled on all of them (a step below the tolerance, or
+  // after three iterations), and the fit ends when it settles again with the points it keeps.
+  bool dropping = false;
   for (int it = 0; it < 20; ++it) {
-    // The normal equations J^T J (symmetric: six sums) and J^T r, summed as scalars.
+    // The normal equations J^T J (symmetric: six sums) and J^T r.
     double h00 = 0, h01 = 0, h02 = 0, h11 = 0, h12 = 0, h22 = 0, g0 = 0, g1 = 0, g2 = 0;
     const double cs = std::cos(theta), sn = std::sin(theta);
     double sum2 = 0;
     int n = 0, ends = 0, sides = 0;
-    const double drop = std::max(min_drop, 3.0 * rms);
-    const bool dropping = it > 2;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      if (!use[i]) continue;  // once dropped, a point stays dropped
-      const double dx = pts[i].x() - c.x(), dy = pts[i].y() - c.y();
-      const double qx = cs * dx + sn * dy, qy = -sn * dx + cs * dy;
-      double r, j0, j1, j2;
-      if (rectangle) {
+    const double drop = dropping ? std::max(min_drop, 3.0 * rms) : HUGE_VAL;
+    if (rectangle) {
+      // In the lamp's frame q = R^T (p - c), a point is on an end (|q_x| = a) or a side
+      // (|q_y| = b), whichever is nearer; s is the sign of that coordinate. dq/dc = -R^T and
+      // dq/dtheta = (q_y, -q_x), so an end's Jacobian row is s (-cos, -sin, q_y) and a side's
+      // s (sin, -cos, -q_x): each class adds to J^T J a fixed part times its count plus its sums
+      // of q and q^2, and to J^T r its sums of s r and s r q. Without branches, point by point.
+      double n_end = 0, q_end = 0, qq_end = 0, sr_end = 0, srq_end = 0;
+      double n_side = 0, q_side = 0, qq_side = 0, sr_side = 0, srq_side = 0;
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        const double dx = pts[i].x() - c.x(), dy = pts[i].y() - c.y();
+        const double qx = cs * dx + sn * dy, qy = -sn * dx + cs * dy;
         const double rx = std::fabs(qx) - a, ry = std::fabs(qy) - b;
         const bool end = std::fabs(rx) < std::fabs(ry);
-        const double s = end ? (qx >= 0 ? 1.0 : -1.0) : (qy >= 0 ? 1.0 : -1.0);
-        r = end ? rx : ry;
-        // q = R^T (p - c): dq/dc = -R^T, dq/dtheta = (q_y, -q_x).
-        if (end) {
-          j0 = -s * cs, j1 = -s * sn, j2 = s * qy;
-        } else {
-          j0 = s * sn, j1 = -s * cs, j2 = -s * qx;
-        }
-        if (dropping && std::fabs(r) > drop) {
-          use[i] = 0;
-          continue;
-        }
-        (end ? ends : sides) += 1;
-      } else {
+        const double r = end ? rx : ry;
+        // Once dropped, a point stays dropped.
+        const bool kept = use[i] && std::fabs(r) <= drop;
+        use[i] = kept;
+        const double we = kept && end ? 1.0 : 0.0, ws = kept && !end ? 1.0 : 0.0;
+        const double srx = qx >= 0 ? rx : -rx, sry = qy >= 0 ? ry : -ry;
+        n_end += we, q_end += we * qy, qq_end += we * qy * qy;
+        sr_end += we * srx, srq_end += we * srx * qy;
+        n_side += ws, q_side += ws * qx, qq_side += ws * qx * qx;
+        sr_side += ws * sry, srq_side += ws * sry * qx;
+        sum2 += (we + ws) * r * r;
+      }
+      ends = static_cast<int>(n_end);
+      sides = static_cast<int>(n_side);
+      n = ends + sides;
+      h00 = n_end * cs * cs + n_side * sn * sn;
+      h01 = (n_end - n_side) * cs * sn;
+      h11 = n_end * sn * sn + n_side * cs * cs;
+      h02 = -cs * q_end - sn * q_side;
+      h12 = -sn * q_end + cs * q_side;
+      h22 = qq_end + qq_side;
+      g0 = -cs * sr_end + sn * sr_side;
+      g1 = -sn * sr_end - cs * sr_side;
+      g2 = srq_end - srq_side;
+    } else {
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        if (!use[i]) continue;  // once dropped, a point stays dropped
+        const double dx = pts[i].x() - c.x(), dy = pts[i].y() - c.y();
         const double dn = std::sqrt(dx * dx + dy * dy);
         if (dn < 1e-12) continue;
-        r = dn - a;
-        j0 = -dx / dn, j1 = -dy / dn, j2 = 0.0;
-        if (dropping && std::fabs(r) > drop) {
+        const double r = dn - a;
+        if (std::fabs(r) > drop) {
           use[i] = 0;
           continue;
         }
+        const double j0 = -dx / dn, j1 = -dy / dn;
+        h00 += j0 * j0, h01 += j0 * j1, h11 += j1 * j1;
+        g0 += j0 * r, g1 += j1 * r;
+        sum2 += r * r;
+        ++n;
       }
-      h00 += j0 * j0, h01 += j0 * j1, h02 += j0 * j2;
-      h11 += j1 * j1, h12 += j1 * j2, h22 += j2 * j2;
-      g0 += j0 * r, g1 += j1 * r, g2 += j2 * r;
-      sum2 += r * r;
-      ++n;
     }
     if (n < 12) return fit;
     rms = std::sqrt(sum2 / n);
@@ -109,7 +129,9 @@ ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Ve
     const Eigen::Vector3d step = -JtJ.ldlt().solve(Jtr);
     c += step.head<2>();
     theta += step(2);
-    if (step.head<2>().norm() < 1e-6 && std::fabs(step(2)) < 1e-5 && it > 3) break;
+    const bool settled = step.head<2>().norm() < 1e-6 && std::fabs(step(2)) < 1e-5;
+    if (settled && dropping) break;
+    dropping = dropping || settled || it >= 2;
   }
   fit.centre = c;
   fit.orientation = theta;
@@ -197,7 +219,8 @@ struct LampDetector::Impl {
   detail::RunOpening opening;
   std::vector<std::uint8_t> opened;
   EdgePoints edges;
-  std::vector<char> fit_use;  // fit_shape: which edge points are still in the fit
+  std::vector<char> fit_use;               // fit_shape: which edge points are still in the fit
+  std::vector<std::pair<int, int>> visit;  // complete: a row's columns to look at
 
   Impl(const CameraDescription& camera, const LampShapePrior& p, const LampDetectorOptions& opt)
       : model(camera), prior(p), o(opt), w(camera.width), h(camera.height) {
@@ -240,7 +263,43 @@ struct LampDetector::Impl {
     area_max = face / (prior.min_distance * prior.min_distance);
     min_pixels = o.min_area_fraction * area_min / w_max * 0.8;
     max_pixels = o.max_area_fraction * area_max / w_min * 1.25 + 64;
+    border_chord = shortest_border_chord();
   }
+
+  // The fewest pixels of the left or right image column that a blob measured as a lamp can cover
+  // there (see LampDetector::border_chord_px). A straight image side cuts a lamp in one of three
+  // ways. Across two opposite sides of a rectangle: the chord is at least its short side. Across
+  // a corner only (one corner in view): the visible part is a right triangle on the chord, of
+  // area at most chord^2 / 4, and it holds at least min_pixels. Leaving one corner out (three in
+  // view): the chord can be short, but the lamp was cut across two sides on its way in, unless it
+  // moved by its own width in one frame. A disc: the visible segment holds min_pixels.
+  double shortest_border_chord() const {
+    // The most and the least a step of one pixel down a side column moves in the normalized
+    // plane: the fewest and the most pixels a length there spans.
+    double most = 0, least = 1e9;
+    for (int u : {0, w - 1}) {
+      for (int v = 0; v + 1 < h; ++v) {
+        const double d = std::hypot(lut_x[index(u, v + 1)] - lut_x[index(u, v)],
+                                    lut_y[index(u, v + 1)] - lut_y[index(u, v)]);
+        most = std::max(most, d);
+        least = std::min(least, d);
+      }
+    }
+    if (prior.rectangle) {
+      const double across = prior.width / prior.max_distance / most;
+      return std::min(across, 2 * std::sqrt(min_pixels));
+    }
+    // A segment of a disc of radius r (px, the largest image: the flattest segment of a given
+    // area) cut at half-angle a has area r^2 (a - sin a cos a) and chord 2 r sin a.
+    const double r = 0.5 * prior.length / prior.min_distance / least;
+    double lo = 0, hi = M_PI / 2;
+    for (int i = 0; i < 60; ++i) {
+      const double a = 0.5 * (lo + hi);
+      (r * r * (a - std::sin(a) * std::cos(a)) < min_pixels ? lo : hi) = a;
+    }
+    return std::min(2 * r * std::sin(lo), prior.length / prior.max_distance / most);
+  }
+  double border_chord = 1;
 
   std::size_t index(int u, int v) const { return static_cast<std::size_t>(v) * w + u; }
 
@@ -249,12 +308,14 @@ struct LampDetector::Impl {
   // Measures the blobs of the last labelling into `out`; false when one spills out of `box`.
   bool measure_blobs(const ImageView& g, const PixelBox& box, LampDetections& out);
   bool measure(const detail::Blob& c, const ImageView& g, LampDetection& out, DetectionStats& st);
-  bool complete(const detail::Blob& c, const ImageView& g, int pad, LampDetection& out);
-  // Of the opened mask of blob `c` (padded by `pad`, `mw` wide): its moments, the pixel nearest
-  // the middle of its box, and whether it reaches the image's border.
+  bool complete(const detail::Blob& c, const ImageView& g, int pad, const detail::RunMask& open,
+                LampDetection& out);
+  // Of the opened mask of blob `c` (padded by `pad`): its moments, the pixel nearest the middle
+  // of its box, and whether it reaches the image's border.
   Moments moments(const detail::Blob& c, int pad, const detail::RunMask& open) const;
-  std::array<int, 2> seed_near_middle(const detail::Blob& c, int pad, int mw) const;
-  bool touches_image_border(const detail::Blob& c, int pad, int mw) const;
+  std::array<int, 2> seed_near_middle(const detail::Blob& c, int pad,
+                                      const detail::RunMask& open) const;
+  bool touches_image_border(const detail::Blob& c, int pad, const detail::RunMask& open) const;
 };
 
 LampDetections LampDetector::Impl::detect(const ImageView& image) {
@@ -366,12 +427,6 @@ bool LampDetector::Impl::measure(const detail::Blob& c, const ImageView& g, Lamp
   mask_runs.end_rows();
   if (r > 0) opening.open(mask_runs, r, opened_runs);
   const detail::RunMask& open_runs = r > 0 ? opened_runs : mask_runs;
-  // The opened mask as bytes too, for the seed, the border test and completion's edges.
-  opened.assign(static_cast<std::size_t>(mw) * mh, 0);
-  for (int y = 0; y < mh; ++y)
-    for (const detail::Span* sp = open_runs.row_begin(y); sp != open_runs.row_end(y); ++sp)
-      std::memset(opened.data() + static_cast<std::size_t>(y) * mw + sp->a, 1,
-                  static_cast<std::size_t>(sp->b - sp->a + 1));
   // Moments in undistorted normalized coordinates, each pixel weighted by the area it covers.
   const Moments m = moments(c, pad, open_runs);
   if (m.pixels == 0 || m.m0 <= 0) {
@@ -382,9 +437,9 @@ bool LampDetector::Impl::measure(const detail::Blob& c, const ImageView& g, Lamp
   const double half_sum = 0.5 * (mu20 + mu02);
   const double root = std::sqrt(0.25 * (mu20 - mu02) * (mu20 - mu02) + mu11 * mu11);
   const double l1 = half_sum + root, l2 = std::max(0.0, half_sum - root);
-  out.seed = seed_near_middle(c, pad, mw);
+  out.seed = seed_near_middle(c, pad, open_runs);
   // After the opening: a fringe pixel at the border is no cut.
-  const bool touches_border = touches_image_border(c, pad, mw);
+  const bool touches_border = touches_image_border(c, pad, open_runs);
   out.centre = Vector2d(cx, cy);
   out.orientation = wrap_axis_angle(0.5 * std::atan2(2 * mu11, mu20 - mu02));
   // Uniform rectangle: variance L^2 / 12 along a side; uniform disc: D^2 / 16 on any axis.
@@ -419,7 +474,7 @@ bool LampDetector::Impl::measure(const detail::Blob& c, const ImageView& g, Lamp
   } else {
     out.view = LampView::partial;
     if (out.visible_fraction >= o.complete_min_fraction) {
-      if (complete(c, g, pad, out)) {
+      if (complete(c, g, pad, open_runs, out)) {
         out.view = LampView::completed;
       } else {
         ++st.completion_failed;
@@ -463,50 +518,69 @@ Moments LampDetector::Impl::moments(const detail::Blob& c, int pad,
 }
 
 std::array<int, 2> LampDetector::Impl::seed_near_middle(const detail::Blob& c, int pad,
-                                                        int mw) const {
-  // The set pixel with the least |u - mid_u| + |v - mid_v|, the first in row order on ties:
-  // each row searched outwards from mid_u, left before right, while it can still do better.
+                                                        const detail::RunMask& open) const {
+  // The set pixel with the least |u - mid_u| + |v - mid_v|, the first in row order on ties, and
+  // left of mid_u before right of it in a row.
   const int mid_u = (c.u0 + c.u1) / 2, mid_v = (c.v0 + c.v1) / 2;
   int best = 1 << 30;
   std::array<int, 2> seed{mid_u, mid_v};
   for (int v = c.v0; v <= c.v1; ++v) {
     const int dv = std::abs(v - mid_v);
     if (dv >= best) continue;
-    const std::uint8_t* row =
-        opened.data() + static_cast<std::size_t>(v - c.v0 + pad) * mw + pad - c.u0;
-    for (int t = 0; dv + t < best; ++t) {
-      const int left = mid_u - t, right = mid_u + t;
-      if (left < c.u0 && right > c.u1) break;
-      const int u = left >= c.u0 && row[left] ? left : right <= c.u1 && row[right] ? right : -1;
-      if (u < 0) continue;
-      best = dv + t;
-      seed = {u, v};
-      break;
+    const int y = v - c.v0 + pad;
+    int t_row = 1 << 30, u_row = mid_u;
+    for (const detail::Span* sp = open.row_begin(y); sp != open.row_end(y); ++sp) {
+      // The span in image columns, within the blob's box.
+      const int a = std::max(sp->a - pad + c.u0, c.u0), b = std::min(sp->b - pad + c.u0, c.u1);
+      if (a > b) continue;
+      const int u = b < mid_u ? b : a > mid_u ? a : mid_u;
+      const int t = std::abs(u - mid_u);
+      if (t < t_row || (t == t_row && u < mid_u)) t_row = t, u_row = u;
+    }
+    if (dv + t_row < best) {
+      best = dv + t_row;
+      seed = {u_row, v};
     }
   }
   return seed;
 }
 
-bool LampDetector::Impl::touches_image_border(const detail::Blob& c, int pad, int mw) const {
-  auto at = [&](int u, int v) {
-    return opened[static_cast<std::size_t>(v - c.v0 + pad) * mw + pad + (u - c.u0)] != 0;
+bool LampDetector::Impl::touches_image_border(const detail::Blob& c, int pad,
+                                              const detail::RunMask& open) const {
+  // A set pixel of the blob's box on the image's first or last row or column.
+  auto row_has = [&](int v) {
+    const int y = v - c.v0 + pad;
+    for (const detail::Span* sp = open.row_begin(y); sp != open.row_end(y); ++sp)
+      if (sp->b >= pad && sp->a <= pad + (c.u1 - c.u0)) return true;
+    return false;
   };
-  for (int u = c.u0; u <= c.u1; ++u)
-    if ((c.v0 == 0 && at(u, 0)) || (c.v1 == h - 1 && at(u, h - 1))) return true;
-  for (int v = c.v0; v <= c.v1; ++v)
-    if ((c.u0 == 0 && at(0, v)) || (c.u1 == w - 1 && at(w - 1, v))) return true;
-  return false;
+  auto column_has = [&](int u) {
+    const int x = pad + (u - c.u0);
+    for (int v = c.v0; v <= c.v1; ++v) {
+      const int y = v - c.v0 + pad;
+      for (const detail::Span* sp = open.row_begin(y); sp != open.row_end(y); ++sp)
+        if (sp->a <= x && x <= sp->b) return true;
+    }
+    return false;
+  };
+  return (c.v0 == 0 && row_has(0)) || (c.v1 == h - 1 && row_has(h - 1)) ||
+         (c.u0 == 0 && column_has(0)) || (c.u1 == w - 1 && column_has(w - 1));
 }
 
 // Completion of a lamp cut by the image border (paper 2, Fig. 5): the visible edges, located to a
 // fraction of a pixel where the grey level crosses the threshold, are fitted with the known shape.
 bool LampDetector::Impl::complete(const detail::Blob& c, const ImageView& g, int pad,
-                                  LampDetection& out) {
+                                  const detail::RunMask& open, LampDetection& out) {
   edges.clear();
   const double level = o.threshold - 0.5;
   // The opened mask of measure(), padded: a pixel's 4-neighbours are always in it. Inside the
   // image it is the visible lamp exactly (its extension past a cut lies outside the image).
-  const int mw = c.u1 - c.u0 + 1 + 2 * pad;
+  const int mw = c.u1 - c.u0 + 1 + 2 * pad, mh = c.v1 - c.v0 + 1 + 2 * pad;
+  opened.assign(static_cast<std::size_t>(mw) * mh, 0);
+  for (int y = 0; y < mh; ++y)
+    for (const detail::Span* sp = open.row_begin(y); sp != open.row_end(y); ++sp)
+      std::memset(opened.data() + static_cast<std::size_t>(y) * mw + sp->a, 1,
+                  static_cast<std::size_t>(sp->b - sp->a + 1));
   auto edge = [&](int u, int v, int un, int vn, std::uint8_t gi, std::uint8_t go) {
     const double t = gi > go ? std::clamp((gi - level) / (gi - go), 0.0, 1.0) : 0.5;
     const std::size_t a = index(u, v), b = index(un, vn);
@@ -516,45 +590,61 @@ bool LampDetector::Impl::complete(const detail::Blob& c, const ImageView& g, int
   Vector2d border_sum = Vector2d::Zero();
   int border_n = 0;
   const std::size_t stride = g.row_stride();
+  const int box_w = c.u1 - c.u0 + 1;
   for (int v = c.v0; v <= c.v1; ++v) {
-    const std::uint8_t* row = opened.data() + static_cast<std::size_t>(v - c.v0 + pad) * mw + pad;
+    const int y = v - c.v0 + pad;
+    const std::uint8_t* row = opened.data() + static_cast<std::size_t>(y) * mw + pad;
     const std::uint8_t* grey_row = g.data + static_cast<std::size_t>(v) * stride;
     const bool border_row = v == 0 || v == h - 1;
-    const int n = c.u1 - c.u0 + 1;
-    for (int j = detail::next_column(row, 0, n, 1, true); j < n;) {
-      if (!row[j]) {
-        j = detail::next_column(row, j, n, 1, true);
+    // The pixels that can be on an edge or the image's border, from the runs: each run's ends,
+    // its stretches not under a run of the row above or below, and all of it on the image's top
+    // or bottom row (an end of a run is also where it meets the image's first or last column).
+    // Columns j = u - c.u0, in the blob's box; visited in order, as the pixels of the row.
+    visit.clear();
+    for (const detail::Span* sp = open.row_begin(y); sp != open.row_end(y); ++sp) {
+      const int a = std::max(sp->a - pad, 0), b = std::min(sp->b - pad, box_w - 1);
+      if (a > b) continue;
+      if (border_row) {
+        visit.push_back({a, b});
         continue;
       }
-      // Eight pixels inside a run whose neighbours above and below are all set have no edge
-      // and are not at the image's border (the run goes on on both sides): skipped at once.
-      if (!border_row && j > 0 && row[j - 1] && j + 8 < n && row[j + 8]) {
-        std::uint64_t r8, a8, b8;
-        std::memcpy(&r8, row + j, 8);
-        std::memcpy(&a8, row + j - mw, 8);
-        std::memcpy(&b8, row + j + mw, 8);
-        if ((r8 & a8 & b8) == 0x0101010101010101ull) {
-          j += 8;
-          continue;
+      visit.push_back({a, a});
+      visit.push_back({b, b});
+      for (const int other : {y - 1, y + 1}) {
+        int from = a;
+        for (const detail::Span* t = open.row_begin(other); t != open.row_end(other); ++t) {
+          const int ta = t->a - pad, tb = t->b - pad;
+          if (tb < from) continue;
+          if (ta > b) break;
+          if (ta > from) visit.push_back({from, ta - 1});
+          from = std::max(from, tb + 1);
+          if (from > b) break;
         }
+        if (from <= b) visit.push_back({from, b});
       }
-      const int u = c.u0 + j++;
-      const int jj = j - 1;
-      const bool left = u > 0 && !row[jj - 1], right = u < w - 1 && !row[jj + 1];
-      const bool below = v < h - 1 && !row[jj + mw], above = v > 0 && !row[jj - mw];
-      const bool at_border = u == 0 || v == 0 || u == w - 1 || v == h - 1;
-      if (at_border) {
-        const std::size_t i = index(u, v);
-        border_sum += Vector2d(lut_x[i], lut_y[i]);
-        ++border_n;
+    }
+    std::sort(visit.begin(), visit.end());
+    int next = 0;  // the first column not visited yet
+    for (const auto& [first, last] : visit) {
+      for (int j = std::max(first, next); j <= last; ++j) {
+        const int u = c.u0 + j;
+        const bool left = u > 0 && !row[j - 1], right = u < w - 1 && !row[j + 1];
+        const bool below = v < h - 1 && !row[j + mw], above = v > 0 && !row[j - mw];
+        const bool at_border = u == 0 || v == 0 || u == w - 1 || v == h - 1;
+        if (at_border) {
+          const std::size_t i = index(u, v);
+          border_sum += Vector2d(lut_x[i], lut_y[i]);
+          ++border_n;
+        }
+        if (!(left || right || below || above)) continue;
+        const std::uint8_t gi = grey_row[u];
+        // The neighbours in the order right, left, below, above.
+        if (right) edge(u, v, u + 1, v, gi, grey_row[u + 1]);
+        if (left) edge(u, v, u - 1, v, gi, grey_row[u - 1]);
+        if (below) edge(u, v, u, v + 1, gi, (grey_row + stride)[u]);
+        if (above) edge(u, v, u, v - 1, gi, (grey_row - stride)[u]);
       }
-      if (!(left || right || below || above)) continue;
-      const std::uint8_t gi = grey_row[u];
-      // The neighbours in the order right, left, below, above.
-      if (right) edge(u, v, u + 1, v, gi, grey_row[u + 1]);
-      if (left) edge(u, v, u - 1, v, gi, grey_row[u - 1]);
-      if (below) edge(u, v, u, v + 1, gi, (grey_row + stride)[u]);
-      if (above) edge(u, v, u, v - 1, gi, (grey_row - stride)[u]);
+      next = std::max(next, last + 1);
     }
   }
   if (edges.size() < 16 || border_n == 0) return false;
@@ -610,6 +700,7 @@ LampDetections LampDetector::detect_in(const ImageView& image, std::vector<Pixel
   return impl_->detect_in(image, std::move(windows));
 }
 double LampDetector::expected_area() const { return impl_->area_nominal; }
+double LampDetector::border_chord_px() const { return impl_->border_chord; }
 const LampShapePrior& LampDetector::prior() const { return impl_->prior; }
 const LampDetectorOptions& LampDetector::options() const { return impl_->o; }
 int LampDetector::width() const { return impl_->w; }

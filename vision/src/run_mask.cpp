@@ -55,6 +55,15 @@ void intersect(std::vector<Span>& x, const Span* first, const Span* last, std::v
   x.swap(tmp);
 }
 
+constexpr int kMaxDirect = 15;  // rows joined without the general merge: radius 7 at most
+
+// Rows y0..y1 (inclusive) hold one span each.
+bool single_spans(const RunMask& in, int y0, int y1) {
+  for (int j = y0; j <= y1; ++j)
+    if (in.row_end(j) - in.row_begin(j) != 1) return false;
+  return true;
+}
+
 // Along columns: row y in [r, h - r) is the AND (erosion) or OR (dilation) of rows y - r .. y + r;
 // the rows nearer the edge are empty.
 void along_columns(const RunMask& in, int r, bool erode, RunMask& out, std::vector<Span>& x,
@@ -64,6 +73,36 @@ void along_columns(const RunMask& in, int r, bool erode, RunMask& out, std::vect
   for (int y = 0; y < h; ++y) {
     out.begin_row();
     if (y < r || y >= h - r) continue;
+    // The common case, a convex blob: one span in each of the 2r + 1 rows, joined directly.
+    if (2 * r + 1 <= kMaxDirect && single_spans(in, y - r, y + r)) {
+      if (erode) {
+        int a = in.row_begin(y - r)->a, b = in.row_begin(y - r)->b;
+        for (int j = y - r + 1; j <= y + r; ++j)
+          a = std::max(a, in.row_begin(j)->a), b = std::min(b, in.row_begin(j)->b);
+        if (a <= b) out.add(a, b);
+        continue;
+      }
+      // Sorted by their first column (insertion: a handful), then joined where they touch.
+      Span sorted[kMaxDirect];
+      int n = 0;
+      for (int j = y - r; j <= y + r; ++j) {
+        const Span s = *in.row_begin(j);
+        int k = n++;
+        for (; k > 0 && sorted[k - 1].a > s.a; --k) sorted[k] = sorted[k - 1];
+        sorted[k] = s;
+      }
+      Span cur = sorted[0];
+      for (int k = 1; k < n; ++k) {
+        if (sorted[k].a <= cur.b + 1) {
+          cur.b = std::max(cur.b, sorted[k].b);
+          continue;
+        }
+        out.add(cur.a, cur.b);
+        cur = sorted[k];
+      }
+      out.add(cur.a, cur.b);
+      continue;
+    }
     x.assign(in.row_begin(y - r), in.row_end(y - r));
     if (erode) {
       for (int j = y - r + 1; j <= y + r && !x.empty(); ++j)

@@ -105,6 +105,10 @@ class LampDetector {
 
   // Expected normalized area of a whole lamp at the nominal distance.
   double expected_area() const;
+  // A lower bound on the pixels of the image's left or right column that a blob reported as a
+  // lamp covers when the column cuts it: a tracker may read those columns this many pixels apart
+  // and still see every lamp entering there (see LampTracker).
+  double border_chord_px() const;
   const LampShapePrior& prior() const;
   const LampDetectorOptions& options() const;
   int width() const;
