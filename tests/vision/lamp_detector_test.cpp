@@ -359,15 +359,7 @@ void expect_side_columns_cut_lamps_by_the_border_chord(const CameraDescription& 
 TEST(LampDetector, LampsEnteringByASideCoverTheBorderChordOfItsColumn) {
   const World w;
   expect_side_columns_cut_lamps_by_the_border_chord(w.camera(), 1000);
-  CameraDescription c = w.camera();
-  const double scale = 640.0 / c.width;
-  c.pinhole.fx *= scale;
-  c.pinhole.fy *= scale;
-  c.width = 640;
-  c.height = 480;
-  c.pinhole.cx = 0.5 * (c.width - 1);
-  c.pinhole.cy = 0.5 * (c.height - 1);
-  expect_side_columns_cut_lamps_by_the_border_chord(c, 600);
+  expect_side_columns_cut_lamps_by_the_border_chord(w.camera_640(), 600);
 }
 
 TEST(LampDetector, NoLampInNoiseOrOnBrightFringes) {

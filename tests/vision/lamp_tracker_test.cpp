@@ -220,15 +220,7 @@ TEST(LampTracker, WindowedFramesReportTheLampsOfWholeFrames) {
 
 TEST(LampTracker, WindowedFramesReportTheLampsOfWholeFramesAt640) {
   const World w;
-  CameraDescription c = w.camera();
-  const double scale = 640.0 / c.width;
-  c.pinhole.fx *= scale;
-  c.pinhole.fy *= scale;
-  c.width = 640;
-  c.height = 480;
-  c.pinhole.cx = 0.5 * (c.width - 1);
-  c.pinhole.cy = 0.5 * (c.height - 1);
-  expect_windows_match_whole_frames(c);
+  expect_windows_match_whole_frames(w.camera_640());
 }
 
 TEST(LampTracker, OptionsAreChecked) {
