@@ -285,6 +285,7 @@ struct LampDetector::Impl {
         least = std::min(least, d);
       }
     }
+    if (!(most > 0 && least > 0)) return 1;  // a degenerate lens: read every pixel
     if (prior.rectangle) {
       const double across = prior.width / prior.max_distance / most;
       return std::min(across, 2 * std::sqrt(min_pixels));

@@ -66,7 +66,8 @@ struct LampTracker::Impl {
         o(options),
         threshold(static_cast<std::uint8_t>(detector_options.threshold)) {
     o.validate();
-    column_every = std::clamp(static_cast<int>(detector.border_chord_px() / 3), 1, 64);
+    const double third = detector.border_chord_px() / 3;
+    column_every = third >= 1 ? static_cast<int>(std::min(third, 64.0)) : 1;
   }
 
   TrackedFrame process(const ImageView& image);
