@@ -7,11 +7,13 @@
 // Windowed tracking: each track predicts where its lamp will be in the next frame (its last image
 // motion, constant velocity), and between full detections the tracker reads only windows around
 // those predictions, around the small blobs cut by the border (a lamp entering or leaving), and
-// the one-pixel ring of the image border, which every lamp entering the view must cross. A frame
-// is read whole on a schedule, after a reset, and whenever the windows cannot vouch for the frame:
-// something bright on the border ring outside every window, a blob reaching a window's edge, a
-// track whose lamp is not in its window. A blob wholly inside a window is measured exactly as a
-// full detection measures it, so windowed frames report the same lamps.
+// the one-pixel ring of the image border, which every lamp entering the view must cross (its left
+// and right columns read every LampDetector::border_chord_px() / 3 pixels, so that a lamp
+// entering there covers three of the pixels read). A frame is read whole on a schedule, after a
+// reset, and whenever the windows cannot vouch for the frame: something bright on the border ring
+// outside every window, a blob reaching a window's edge, a track whose lamp is not in its window.
+// A blob wholly inside a window is measured exactly as a full detection measures it, so windowed
+// frames report the same lamps.
 
 #include <memory>
 #include <vector>
