@@ -55,6 +55,22 @@ void intersect(std::vector<Span>& x, const Span* first, const Span* last, std::v
   x.swap(tmp);
 }
 
+// Adds the spans [first, last), sorted by their first column, to the current row of `out`, those
+// that overlap or touch joined into one.
+void add_joined(const Span* first, const Span* last, RunMask& out) {
+  if (first == last) return;
+  Span cur = *first;
+  for (const Span* s = first + 1; s != last; ++s) {
+    if (s->a <= cur.b + 1) {
+      cur.b = std::max(cur.b, s->b);
+      continue;
+    }
+    out.add(cur.a, cur.b);
+    cur = *s;
+  }
+  out.add(cur.a, cur.b);
+}
+
 constexpr int kMaxDirect = 15;  // rows joined without the general merge: radius 7 at most
 
 // Rows y0..y1 (inclusive) hold one span each.
@@ -91,16 +107,7 @@ void along_columns(const RunMask& in, int r, bool erode, RunMask& out, std::vect
         for (; k > 0 && sorted[k - 1].a > s.a; --k) sorted[k] = sorted[k - 1];
         sorted[k] = s;
       }
-      Span cur = sorted[0];
-      for (int k = 1; k < n; ++k) {
-        if (sorted[k].a <= cur.b + 1) {
-          cur.b = std::max(cur.b, sorted[k].b);
-          continue;
-        }
-        out.add(cur.a, cur.b);
-        cur = sorted[k];
-      }
-      out.add(cur.a, cur.b);
+      add_joined(sorted, sorted + n, out);
       continue;
     }
     x.assign(in.row_begin(y - r), in.row_end(y - r));
@@ -111,19 +118,7 @@ void along_columns(const RunMask& in, int r, bool erode, RunMask& out, std::vect
       for (int j = y - r + 1; j <= y + r; ++j) x.insert(x.end(), in.row_begin(j), in.row_end(j));
       std::sort(x.begin(), x.end(), [](const Span& s, const Span& t) { return s.a < t.a; });
     }
-    // Sorted; spans that overlap or touch are joined (only a union has any).
-    bool open = false;
-    Span cur;
-    for (const Span& s : x) {
-      if (open && s.a <= cur.b + 1) {
-        cur.b = std::max(cur.b, s.b);
-        continue;
-      }
-      if (open) out.add(cur.a, cur.b);
-      cur = s;
-      open = true;
-    }
-    if (open) out.add(cur.a, cur.b);
+    add_joined(x.data(), x.data() + x.size(), out);  // only a union has spans to join
   }
   out.end_rows();
 }
