@@ -150,8 +150,10 @@ SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
                                pb.wheels[k][1] - pb.wheels[k - 1][1], pb.semi_axis, sxy, syaw)),
         nullptr, pb.poses[k - 1].data(), pb.poses[k].data(), &pb.wheel_difference);
   }
-  // One shared height per kind of lamp (rectangles, discs): estimated by a whole solve, held by
-  // a windowed one.
+  // One shared height per kind of lamp (rectangles, discs), estimated by every solve: a windowed
+  // one that held it at the mean of the heights as they stood would pull the lamps towards the
+  // height new lamps are first placed at, and under a ceiling higher than that guess the map's
+  // heights would creep up only as fast as windows passed.
   double kind_height[2] = {0, 0};
   int kind_count[2] = {0, 0};
   for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
@@ -168,10 +170,6 @@ SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
                                    new HeightFactor(o.shared_height_sigma)),
                                &height_loss, pb.lamps[i].data(),
                                &kind_height[pb.rectangle[i] ? 0 : 1]);
-    }
-    for (int k = 0; k < 2; ++k) {
-      if (!whole && problem.HasParameterBlock(&kind_height[k]))
-        problem.SetParameterBlockConstant(&kind_height[k]);
     }
   }
   bool any_rectangle = false;

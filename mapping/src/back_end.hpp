@@ -36,8 +36,8 @@ struct SolveReport {
 
 // Solves the problem in place; the first keyframe is held fixed (it is the map frame). With
 // `first_free` > 0 only the keyframes from it on and the lamps they see move (their sightings
-// from earlier keyframes anchor them); the wheels, the building's axis and the shared heights
-// are held.
+// from earlier keyframes anchor them); the wheels and the building's axis are held. The shared
+// height of each kind of lamp is estimated by every solve.
 SolveReport solve(MappingProblem& problem, const fusion::CeilingGeometry& geometry,
                   const LampMapperOptions& options, double focal_px, std::size_t first_free = 0);
 

@@ -20,6 +20,7 @@ void LampMapperOptions::validate() const {
     if (!ok) throw InputError({"lamp mapper options", "", field}, what);
   };
   check(gate_m > 0 && gate_m < 5, "gate_m", "must be 0 to 5 m");
+  check(track_gate > 0 && track_gate < 1, "track_gate", "must be 0 to 1");
   check(height_guess_m > 0 && height_guess_m < 50, "height_guess_m", "must be 0 to 50 m");
   check(keyframe_m > 0 && keyframe_m < 10, "keyframe_m", "must be 0 to 10 m");
   check(solve_every_m > 0, "solve_every_m", "must be positive");
@@ -40,6 +41,9 @@ void LampMapperOptions::validate() const {
 
 // A landmark seen again after this much travel away from it closes a loop.
 constexpr double kRevisitM = 20.0;
+// Lamps are followed from the last keyframe only when it is at most this many keyframe steps
+// back (frames lost in between): further, a wrong height would move the prediction too far.
+constexpr double kFollowSteps = 3.0;
 
 struct LampMapper::Impl {
   LampMapperOptions o;
@@ -50,9 +54,18 @@ struct LampMapper::Impl {
   std::vector<std::pair<Stamp, std::array<double, 2>>> wheel_log;  // cumulative readings
   MappingProblem pb;
   std::vector<Stamp> stamps;  // per keyframe
-  // Per landmark, the lengths and widths of its sightings (m, at the guessed height).
+  // Per landmark, the lengths and widths of its sightings, seen from unit distance.
   std::vector<std::vector<double>> sizes, widths;
+  // The height a new lamp of each kind (rectangles, discs) is first placed at: the guess, then
+  // the median of the solved lamps of its kind. Placed far from its height, a lamp would move
+  // across the ceiling as the robot passes under it and be taken for another.
+  std::array<double, 2> new_height;
   std::vector<double> last_seen_travel;  // per landmark
+  // The last keyframe's sightings (landmark, normalized centre), pose estimate and travel: a lamp
+  // still in view is followed across the image from there, whatever its height.
+  std::vector<std::pair<int, Vector2d>> last_sightings;
+  Pose2 last_estimate;
+  double last_travel = 0;
   double next_solve_m;
   bool square_set = false;
   bool revisited = false;  // a landmark seen again after a loop since the last whole solve
@@ -65,6 +78,7 @@ struct LampMapper::Impl {
         geometry(camera),
         focal_px(camera.pinhole.fx),
         track(robot.semi_axis, std::chrono::hours(24 * 365)),
+        new_height{options.height_guess_m, options.height_guess_m},
         next_solve_m(options.solve_every_m) {
     o.validate();
     pb.semi_axis = robot.semi_axis;
@@ -117,22 +131,22 @@ struct LampMapper::Impl {
     pb.wheels.push_back(wheels_at(t));
     pb.travel.push_back(travel);
     stamps.push_back(t);
-    const Vector3d& cam = geometry.mount_origin();
     std::vector<bool> taken(pb.lamps.size(), false);
+    std::vector<std::pair<int, Vector2d>> sighted;
     for (const auto& d : lamps) {
       if (d.view != vision::LampView::full) continue;
-      // Where the lamp is on the ceiling, at the height of what it joins (or the guess).
-      const double z0 = o.height_guess_m;
+      // Where the lamp is on the ceiling, at the height of what it joins (or its kind's).
+      const bool rect = d.length > 1.5 * d.width;
+      const double z0 = new_height[rect ? 0 : 1];
       const auto base = geometry.base_point(d.centre, z0);
       if (!base) continue;
       const Vector2d at = est.transform_from(*base);
-      const double range = z0 - cam.z();
-      const double length = d.length * range, width = d.width * range;
-      const bool rect = length > 1.5 * width;
       const double reach = o.gate_m + 2.0 * base->norm() + 0.5;
-      int best = -1;
+      int best = travel - last_travel <= kFollowSteps * o.keyframe_m
+                     ? followed(d.centre, rect, est, taken)
+                     : -1;
       double best_d = o.gate_m;
-      for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
+      for (std::size_t i = 0; best < 0 && i < pb.lamps.size(); ++i) {
         if (taken[i] || pb.rectangle[i] != rect) continue;
         if (!o.close_loops && travel - last_seen_travel[i] > kRevisitM) continue;
         // Far from the guess even for a lamp three times as high above the camera: not a
@@ -172,8 +186,9 @@ struct LampMapper::Impl {
         revisited = true;
       }
       last_seen_travel[best] = travel;
-      sizes[best].push_back(length);
-      widths[best].push_back(width);
+      sizes[best].push_back(d.length);
+      widths[best].push_back(d.width);
+      sighted.emplace_back(best, d.centre);
       pb.sightings.push_back({kf, best, d.centre, d.orientation});
     }
     if (travel >= next_solve_m) {
@@ -191,6 +206,34 @@ struct LampMapper::Impl {
       }
       next_solve_m = travel + o.solve_every_m;
     }
+    last_sightings = std::move(sighted);
+    const auto& q = pb.poses[kf];
+    last_estimate = Pose2(q[0], q[1], q[2]);
+    last_travel = travel;
+  }
+
+  // The landmark the last keyframe saw that a lamp at normalized `centre` is, followed across
+  // the image: its last sighting moved by the robot's motion since, at the landmark's height
+  // (a wrong height moves it by only the keyframe step over the height); -1 when none is
+  // within the tracking gate.
+  int followed(const Vector2d& centre, bool rect, const Pose2& est,
+               const std::vector<bool>& taken) const {
+    int best = -1;
+    double best_d = o.track_gate;
+    for (const auto& [i, n] : last_sightings) {
+      if (taken[i] || pb.rectangle[i] != rect) continue;
+      const auto b = geometry.base_point(n, pb.lamps[i][2]);
+      if (!b) continue;
+      const Vector2d p = last_estimate.transform_from(*b);
+      const auto seen = geometry.predict(est, Vector3d(p.x(), p.y(), pb.lamps[i][2]));
+      if (!seen) continue;
+      const double dist = (*seen - centre).norm();
+      if (dist < best_d) {
+        best_d = dist;
+        best = i;
+      }
+    }
+    return best;
   }
 
   void run_solve(std::size_t first_free = 0, int iterations = 0) {
@@ -201,6 +244,22 @@ struct LampMapper::Impl {
     ++result.solves;
     result.solve_seconds += r.seconds;
     result.final_rms_px = r.rms_px;
+    learn_new_height();
+  }
+
+  // Each kind's median solved height, over the landmarks seen often enough to be kept.
+  void learn_new_height() {
+    std::vector<int> seen(pb.lamps.size(), 0);
+    for (const auto& s : pb.sightings) ++seen[s.lamp];
+    for (int kind = 0; kind < 2; ++kind) {
+      std::vector<double> z;
+      for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
+        if (pb.rectangle[i] == (kind == 0) && seen[i] >= o.min_sightings &&
+            pb.lamps[i][2] > geometry.mount_origin().z())
+          z.push_back(pb.lamps[i][2]);
+      }
+      if (!z.empty()) new_height[kind] = median(z);
+    }
   }
 };
 
@@ -275,9 +334,8 @@ MappingResult LampMapper::finish() {
     MappedLamp l;
     l.xyz = Vector3d(pb.lamps[i][0], pb.lamps[i][1], pb.lamps[i][2]);
     l.shape = pb.rectangle[i] ? graph::LampShape::rectangle : graph::LampShape::disc;
-    // Sizes were measured at the guessed height: rescale to the solved one.
-    const double scale = (l.xyz.z() - m.geometry.mount_origin().z()) /
-                         (m.o.height_guess_m - m.geometry.mount_origin().z());
+    // Sizes were seen from unit distance: at the solved one.
+    const double scale = l.xyz.z() - m.geometry.mount_origin().z();
     l.length = median(m.sizes[i]) * scale;
     l.width = pb.rectangle[i] ? median(m.widths[i]) * scale : l.length;
     l.yaw = pb.rectangle[i] ? wrap_angle(2 * pb.lamps[i][3]) / 2 : 0.0;

@@ -22,8 +22,9 @@ void MapBuildOptions::validate() const {
 
 namespace {
 
-// A detector that takes any bright blob from a few centimetres to metres across, for learning
-// what the building's lamps look like.
+// A detector that takes any bright blob from a thirtieth of a radian to three radians across
+// (a 0.3 m wide lamp 9 m above the camera; one a metre across at 0.3 m), for learning what the
+// building's lamps look like.
 vision::LampShapePrior probe_prior() {
   vision::LampShapePrior p;
   p.rectangle = true;
@@ -31,7 +32,7 @@ vision::LampShapePrior probe_prior() {
   p.width = 1.0;
   p.min_distance = 0.3;
   p.nominal_distance = 1.0;
-  p.max_distance = 8.0;
+  p.max_distance = 30.0;
   return p;
 }
 

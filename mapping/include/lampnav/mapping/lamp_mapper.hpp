@@ -3,10 +3,13 @@
 // landmarks (x, y, height, yaw), estimated together by nonlinear least squares (Ceres Solver) from
 // the wheels and the ceiling camera's lamp detections. The map frame is the robot's start pose.
 //
-// Front end: a keyframe every `keyframe_m` of travel; each lamp the detector saw whole is placed on
-// the ceiling from the current estimate of the pose and joins the nearest landmark of its kind
-// within `gate_m`, or starts a new one. The pose estimate is the dead reckoning corrected by the
-// last solve, so a lamp seen again after a loop is placed with the loop's drift only since then.
+// Front end: a keyframe every `keyframe_m` of travel; each lamp the detector saw whole is first
+// followed from the last keyframe across the image (`track_gate`), whatever its height; else it
+// is placed on the ceiling from the current estimate of the pose and joins the nearest landmark
+// of its kind within `gate_m`, or starts a new one, at the median solved height of its kind
+// (`height_guess_m` before the first solve). The pose estimate is the dead reckoning corrected by
+// the last solve, so a lamp seen again after a loop is placed with the loop's drift only since
+// then.
 // Back end (src/back_end.cpp): odometry factors between keyframes from the wheel noise model,
 // reprojection factors on the lamps' centres in undistorted normalized coordinates (the detector's
 // output), and orientation factors for rectangular lamps; a Huber loss on the camera terms. The
@@ -26,8 +29,11 @@
 namespace lampnav::mapping {
 
 struct LampMapperOptions {
-  double gate_m = 0.5;          // a lamp joins a landmark this close on the ceiling
-  double height_guess_m = 2.7;  // a new lamp's height above the floor before the solver's
+  double gate_m = 0.5;  // a lamp joins a landmark this close on the ceiling
+  // A lamp the last keyframe saw is followed across the image: its predicted centre within this
+  // (normalized image units; 0.08 is 24 px at a focal length of 300 px).
+  double track_gate = 0.08;
+  double height_guess_m = 2.7;  // a new lamp's height above the floor before the first solve
   double keyframe_m = 0.1;      // travel (m, the turning arc counted) between keyframes
   double solve_every_m = 5.0;   // travel between two solves
   double window_m = 30.0;       // a solve moves only the last this much of the drive, unless
