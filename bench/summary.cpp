@@ -351,7 +351,7 @@ int main(int argc, char** argv) {
   grows("replay", "BM_ReplayBuildingMission");
   add("map build from a recorded 10-minute drive (100-node building)", us("BM_MapBuildFromLog/5"),
       "", std::nullopt, 20e6, std::nullopt);
-  for (const char* seed : {"5", "11", "23"}) {
+  for (const char* seed : {"5", "11", "23", "31", "64"}) {
     const std::string bench = std::string("BM_MapBuildFromLog/") + seed;
     const std::string drive = std::string("map of a 10-minute drive, building ") + seed;
     add_value(drive + ", lamp position RMS", counter(bench, "rms_cm", 1), "", std::nullopt, 2.0,
