@@ -54,18 +54,14 @@ struct LampMapper::Impl {
   std::vector<std::pair<Stamp, std::array<double, 2>>> wheel_log;  // cumulative readings
   MappingProblem pb;
   std::vector<Stamp> stamps;  // per keyframe
-  // Per landmark, the lengths and widths of its sightings, seen from unit distance.
+  // Per landmark, the lengths and widths of its sightings, seen from unit distance (one each per
+  // sighting: their count is the landmark's sightings).
   std::vector<std::vector<double>> sizes, widths;
   // The height a new lamp of each kind (rectangles, discs) is first placed at: the guess, then
   // the median of the solved lamps of its kind. Placed far from its height, a lamp would move
   // across the ceiling as the robot passes under it and be taken for another.
   std::array<double, 2> new_height;
   std::vector<double> last_seen_travel;  // per landmark
-  // The last keyframe's sightings (landmark, normalized centre), pose estimate and travel: a lamp
-  // still in view is followed across the image from there, whatever its height.
-  std::vector<std::pair<int, Vector2d>> last_sightings;
-  Pose2 last_estimate;
-  double last_travel = 0;
   double next_solve_m;
   bool square_set = false;
   bool revisited = false;  // a landmark seen again after a loop since the last whole solve
@@ -132,7 +128,13 @@ struct LampMapper::Impl {
     pb.travel.push_back(travel);
     stamps.push_back(t);
     std::vector<bool> taken(pb.lamps.size(), false);
-    std::vector<std::pair<int, Vector2d>> sighted;
+    // The last keyframe's sightings, the last ones in the problem so far: a lamp still in view
+    // is followed across the image from there, when that keyframe is near enough.
+    const std::size_t last_end = pb.sightings.size();
+    std::size_t last_first = last_end;
+    if (kf > 0 && travel - pb.travel[kf - 1] <= kFollowSteps * o.keyframe_m) {
+      while (last_first > 0 && pb.sightings[last_first - 1].keyframe == kf - 1) --last_first;
+    }
     for (const auto& d : lamps) {
       if (d.view != vision::LampView::full) continue;
       // Where the lamp is on the ceiling, at the height of what it joins (or its kind's).
@@ -142,9 +144,7 @@ struct LampMapper::Impl {
       if (!base) continue;
       const Vector2d at = est.transform_from(*base);
       const double reach = o.gate_m + 2.0 * base->norm() + 0.5;
-      int best = travel - last_travel <= kFollowSteps * o.keyframe_m
-                     ? followed(d.centre, rect, est, taken)
-                     : -1;
+      int best = followed(d.centre, rect, est, last_first, last_end, taken);
       double best_d = o.gate_m;
       for (std::size_t i = 0; best < 0 && i < pb.lamps.size(); ++i) {
         if (taken[i] || pb.rectangle[i] != rect) continue;
@@ -188,7 +188,6 @@ struct LampMapper::Impl {
       last_seen_travel[best] = travel;
       sizes[best].push_back(d.length);
       widths[best].push_back(d.width);
-      sighted.emplace_back(best, d.centre);
       pb.sightings.push_back({kf, best, d.centre, d.orientation});
     }
     if (travel >= next_solve_m) {
@@ -206,25 +205,24 @@ struct LampMapper::Impl {
       }
       next_solve_m = travel + o.solve_every_m;
     }
-    last_sightings = std::move(sighted);
-    const auto& q = pb.poses[kf];
-    last_estimate = Pose2(q[0], q[1], q[2]);
-    last_travel = travel;
   }
 
-  // The landmark the last keyframe saw that a lamp at normalized `centre` is, followed across
-  // the image: its last sighting moved by the robot's motion since, at the landmark's height
-  // (a wrong height moves it by only the keyframe step over the height); -1 when none is
-  // within the tracking gate.
-  int followed(const Vector2d& centre, bool rect, const Pose2& est,
-               const std::vector<bool>& taken) const {
+  // The landmark of sightings [first, end) (an earlier keyframe's) that a lamp at normalized
+  // `centre` is, followed across the image: its sighting there moved by the robot's motion
+  // since, at the landmark's height (a wrong height moves it by only the keyframe step over the
+  // height); -1 when none is within the tracking gate.
+  int followed(const Vector2d& centre, bool rect, const Pose2& est, std::size_t first,
+               std::size_t end, const std::vector<bool>& taken) const {
     int best = -1;
     double best_d = o.track_gate;
-    for (const auto& [i, n] : last_sightings) {
+    for (std::size_t k = first; k < end; ++k) {
+      const auto& s = pb.sightings[k];
+      const int i = s.lamp;
       if (taken[i] || pb.rectangle[i] != rect) continue;
-      const auto b = geometry.base_point(n, pb.lamps[i][2]);
+      const auto b = geometry.base_point(s.centre, pb.lamps[i][2]);
       if (!b) continue;
-      const Vector2d p = last_estimate.transform_from(*b);
+      const auto& q = pb.poses[s.keyframe];
+      const Vector2d p = Pose2(q[0], q[1], q[2]).transform_from(*b);
       const auto seen = geometry.predict(est, Vector3d(p.x(), p.y(), pb.lamps[i][2]));
       if (!seen) continue;
       const double dist = (*seen - centre).norm();
@@ -249,12 +247,11 @@ struct LampMapper::Impl {
 
   // Each kind's median solved height, over the landmarks seen often enough to be kept.
   void learn_new_height() {
-    std::vector<int> seen(pb.lamps.size(), 0);
-    for (const auto& s : pb.sightings) ++seen[s.lamp];
     for (int kind = 0; kind < 2; ++kind) {
       std::vector<double> z;
       for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
-        if (pb.rectangle[i] == (kind == 0) && seen[i] >= o.min_sightings &&
+        if (pb.rectangle[i] == (kind == 0) &&
+            static_cast<int>(sizes[i].size()) >= o.min_sightings &&
             pb.lamps[i][2] > geometry.mount_origin().z())
           z.push_back(pb.lamps[i][2]);
       }

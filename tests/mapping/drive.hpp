@@ -2,6 +2,7 @@
 // A drive for mapping tests: through waypoints (turn on the spot, then straight), with wheels that
 // have a scale error and noise, and the ideal lamp detections of the ceiling camera at 10 Hz.
 
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -37,6 +38,11 @@ struct DriveRecord {
   Pose2 start;
   double length_m = 0;
 };
+
+// A copy of `map` with each node passed through `edit` (lamps moved, added or taken out), the
+// edges as they were.
+graph::TopologicalMap edited(const graph::TopologicalMap& map,
+                             const std::function<void(graph::Node&)>& edit);
 
 // The lamp SLAM over a recorded drive, wheels and frames in time order.
 mapping::MappingResult map_drive(const DriveRecord& drive, const RobotDescription& robot,

@@ -193,13 +193,9 @@ TEST(LampMapper, CeilingsFrom2Point4To8MetresHighMapAlike) {
   for (const double height : {2.4, 4.0, 5.0, 8.0}) {
     SCOPED_TRACE("lamps " + std::to_string(height) + " m above the floor");
     Office hung = office;
-    hung.map = graph::TopologicalMap(office.map.name());
-    for (const graph::Node& n : office.map.nodes()) {
-      graph::Node c = n;
+    hung.map = test::edited(office.map, [&](graph::Node& c) {
       for (auto& l : c.lamps) l.xyz.z() = height;
-      hung.map.add_node(c);
-    }
-    for (const auto& e : office.map.edges()) hung.map.add_edge(e);
+    });
     const test::DriveRecord drive = hung.drive(office_loop(2));
     const MappingResult built = build(drive, hung.robot);
     const Accuracy a = compare(built, hung.map, drive);

@@ -18,23 +18,18 @@ using Eigen::Vector2d;
 
 // The office as it is now: two lamps moved, one added (the failed ones are the sensors').
 graph::TopologicalMap changed_office(const graph::TopologicalMap& map) {
-  graph::TopologicalMap world(map.name());
-  for (const graph::Node& n : map.nodes()) {
-    graph::Node c = n;
+  return test::edited(map, [](graph::Node& c) {
     for (auto& l : c.lamps) {
       if (l.id.value == "C5-L2") l.xyz.y() += 0.2;  // along the corridor
       if (l.id.value == "C4-L3") l.xyz.y() += 0.2;  // across it
     }
-    if (n.name == "C6") {
+    if (c.name == "C6") {
       graph::Lamp added = c.lamps[1];
       added.id = LampId("C6-NEW");
       added.xyz.x() = 0.5 * (c.lamps[1].xyz.x() + c.lamps[2].xyz.x());
       c.lamps.insert(c.lamps.begin() + 2, added);
     }
-    world.add_node(c);
-  }
-  for (const auto& e : map.edges()) world.add_edge(e);
-  return world;
+  });
 }
 
 TEST(Survey, FindsTheFailedMovedAndNewLampsAndNothingElse) {
