@@ -205,6 +205,39 @@ double intersection_area(const Polygon& a, const Polygon& b) {
   return area;
 }
 
+Polygon convex_hull(std::vector<Vector2d> pts) {
+  std::sort(pts.begin(), pts.end(), [](const Vector2d& a, const Vector2d& b) {
+    return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y());
+  });
+  pts.erase(std::unique(pts.begin(), pts.end()), pts.end());
+  if (pts.size() < 3) return Polygon(pts);
+  std::vector<Vector2d> hull(2 * pts.size());
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {  // lower chain
+    while (k >= 2 && orient(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
+    hull[k++] = pts[i];
+  }
+  for (std::size_t i = pts.size() - 1, lower = k + 1; i-- > 0;) {  // upper chain
+    while (k >= lower && orient(hull[k - 2], hull[k - 1], pts[i]) <= 0) --k;
+    hull[k++] = pts[i];
+  }
+  hull.resize(k - 1);  // the last point is the first
+  return Polygon(std::move(hull));
+}
+
+Polygon clip_left_of(const Polygon& convex, const Vector2d& a, const Vector2d& b) {
+  const auto& v = convex.vertices();
+  std::vector<Vector2d> out;
+  for (std::size_t j = 0; j < v.size(); ++j) {
+    const Vector2d& p = v[j];
+    const Vector2d& q = v[(j + 1) % v.size()];
+    const double dp = orient(a, b, p), dq = orient(a, b, q);
+    if (dp >= 0) out.push_back(p);
+    if ((dp > 0 && dq < 0) || (dp < 0 && dq > 0)) out.push_back(p + (q - p) * (dp / (dp - dq)));
+  }
+  return Polygon(std::move(out));
+}
+
 double signed_angle(const Vector2d& a, const Vector2d& b) {
   return std::atan2(cross(a, b), a.dot(b));
 }

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <random>
 
 #include "lampnav/graph/geometry.hpp"
@@ -66,6 +67,43 @@ TEST(IntersectionArea, MatchesMonteCarloOnRandomSquares) {
     }
     EXPECT_NEAR(intersection_area(a, b), 49.0 * hits / n, 0.35);
   }
+}
+
+// The hull of random points holds every one of them, is convex and counter-clockwise, and each
+// vertex is one of the points; points on a line have no hull.
+TEST(ConvexHull, HoldsEveryPointAndIsConvex) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-5, 5);
+  for (int trial = 0; trial < 50; ++trial) {
+    std::vector<V> pts(3 + trial);
+    for (auto& p : pts) p = V(u(rng), u(rng));
+    const Polygon h = convex_hull(pts);
+    ASSERT_GE(h.size(), 3u);
+    EXPECT_GT(h.signed_area(), 0);
+    EXPECT_FALSE(h.self_intersects());
+    for (const auto& p : pts) EXPECT_TRUE(h.contains(p, 1e-9));
+    const auto& v = h.vertices();
+    for (std::size_t i = 0; i < v.size(); ++i) {
+      EXPECT_NE(std::find(pts.begin(), pts.end(), v[i]), pts.end());
+      const V a = v[(i + 1) % v.size()] - v[i], b = v[(i + 2) % v.size()] - v[(i + 1) % v.size()];
+      EXPECT_GT(a.x() * b.y() - a.y() * b.x(), 0) << "vertex " << i;  // a left turn at each
+    }
+  }
+  EXPECT_EQ(convex_hull({{0, 0}, {1, 1}, {2, 2}, {1, 1}}).size(), 2u);
+  const Polygon sq = convex_hull({{0, 0}, {2, 0}, {1, 1}, {2, 2}, {0, 2}, {1, 0}});
+  EXPECT_EQ(sq.size(), 4u);
+  EXPECT_DOUBLE_EQ(sq.area(), 4.0);
+}
+
+TEST(ClipLeftOf, KeepsTheLeftSide) {
+  const Polygon sq = square(0, 0, 2);
+  const Polygon left = clip_left_of(sq, V(0.5, 0), V(0.5, 1));  // x <= 0.5 is left going up
+  EXPECT_NEAR(left.area(), 1.0, 1e-12);
+  EXPECT_TRUE(left.contains(V(0.25, 1)));
+  EXPECT_FALSE(left.contains(V(1, 1)));
+  EXPECT_NEAR(clip_left_of(sq, V(5, 0), V(5, 1)).area(), 4.0, 1e-12);  // all of it
+  EXPECT_LT(clip_left_of(sq, V(-1, 0), V(-1, 1)).size(), 3u);          // none of it
+  EXPECT_NEAR(clip_left_of(sq, V(0, 0), V(2, 2)).area(), 2.0, 1e-12);  // the diagonal
 }
 
 TEST(SignedAngle, LeftIsPositive) {

@@ -42,6 +42,13 @@ class Polygon {
 // Area of the intersection of two simple polygons.
 double intersection_area(const Polygon& a, const Polygon& b);
 
+// The smallest convex polygon holding every point, counter-clockwise, without collinear
+// vertices (Andrew's monotone chain). Fewer than three vertices when the points are collinear.
+Polygon convex_hull(std::vector<Eigen::Vector2d> points);
+
+// The part of convex polygon `convex` left of the directed line a -> b (Sutherland-Hodgman).
+Polygon clip_left_of(const Polygon& convex, const Eigen::Vector2d& a, const Eigen::Vector2d& b);
+
 // Signed angle from direction a to direction b, in (-pi, pi]; positive is a left (CCW) turn.
 double signed_angle(const Eigen::Vector2d& a, const Eigen::Vector2d& b);
 
