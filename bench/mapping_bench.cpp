@@ -40,11 +40,13 @@ void BM_MapBuildFromLog(benchmark::State& state) {
   const auto stats = sim::record_mission(s, log_path, {});
   double drive_s = 0;
   graph::TopologicalMap built;
+  std::size_t lamps_outside = 0;
   Pose2 start;
   for (auto _ : state) {
     const io::MissionLog log = io::read_mission_log(log_path);
     const mapping::MapBuildResult r = mapping::build_map(log, log_path, robot, {}, {});
     built = r.map;
+    lamps_outside = r.topology.lamps_outside;
     start = log.truth.front().value.pose;
     drive_s = to_seconds(log.wheels.back().value.stamp - log.wheels.front().value.stamp);
     benchmark::DoNotOptimize(r);
@@ -100,6 +102,12 @@ void BM_MapBuildFromLog(benchmark::State& state) {
   state.counters["scale_error_percent"] = den > 0 ? 100 * (num / den - 1) : 0;
   state.counters["drive_min"] = drive_s / 60;
   state.counters["lamps"] = static_cast<double>(built.lamp_count());
+  // Places (the drive goes corner to corner along corridors: no halls), and lamps in none.
+  double halls = 0;
+  for (const auto& n : built.nodes()) halls += n.place == graph::Place::hall;
+  state.counters["places"] = static_cast<double>(built.node_count());
+  state.counters["halls"] = halls;
+  state.counters["lamps_outside"] = static_cast<double>(lamps_outside);
   state.counters["phantoms"] = phantoms;
   state.counters["rms_cm"] = pairs.empty() ? 0 : 100 * std::sqrt(sum / pairs.size());
   state.counters["max_cm"] = 100 * worst;

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <set>
 
+#include "halls.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/graph/geojson.hpp"
 
@@ -22,27 +24,19 @@ void TopologyOptions::validate() const {
   check(parallel_deg > 0 && parallel_deg < 45, "parallel_deg", "must be 0 to 45 degrees");
   check(gap_m >= 0, "gap_m", "must not be negative");
   check(place_m > 0, "place_m", "must be positive");
+  check(hall_lane_gap_m == 0 || hall_lane_gap_m > same_line_m, "hall_lane_gap_m",
+        "must be 0 (no halls) or more than same_line_m");
+  check(hall_min_overlap_m > 0, "hall_min_overlap_m", "must be positive");
+  check(hall_min_spread_m >= 0, "hall_min_spread_m", "must not be negative");
+  check(hall_margin_m >= 0 && hall_margin_m < 10, "hall_margin_m", "must be 0 to 10 m");
+  check(hall_min_lamps >= 0, "hall_min_lamps", "must not be negative");
+  check(hall_link_m > 0, "hall_link_m", "must be positive");
+  check(hall_link_per_height >= 0, "hall_link_per_height", "must not be negative");
 }
 
 namespace {
 
-// A straight line the drive went along, and the stretches of it driven (as intervals of the
-// distance along it), merged into runs.
-struct Line {
-  Vector2d origin, dir;  // dir canonical: angle in (-pi/2, pi/2]
-  std::vector<std::pair<double, double>> intervals;
-  Vector2d at(double s) const { return origin + s * dir; }
-  double along(const Vector2d& p) const { return (p - origin).dot(dir); }
-  double across(const Vector2d& p) const {
-    const Vector2d d = p - origin;
-    return std::abs(d.x() * dir.y() - d.y() * dir.x());
-  }
-};
-
-struct Run {
-  int line = 0;
-  double s0 = 0, s1 = 0;
-};
+using namespace drive_topology;
 
 struct Place {
   Vector2d point = Vector2d::Zero();
@@ -50,6 +44,9 @@ struct Place {
   std::vector<Vector2d> ways;
   graph::Place kind = graph::Place::junction;
   int node = -1;
+  int hall = -1;  // a hall: its index, its region in `region`
+  graph::Polygon region;
+  std::vector<int> beside;  // the halls next to it
 };
 
 // Douglas-Peucker: indices of the points kept.
@@ -146,6 +143,18 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     }
   }
 
+  // 1b. Halls, and the runs with their stretches through halls cut out.
+  std::vector<graph::Polygon> halls = halls_from_lanes(lines, runs, mapped.lamps, o);
+  if (o.hall_min_lamps > 0) {
+    const auto beside = halls_beside(lines, runs, mapped.lamps, halls, o);
+    halls.insert(halls.end(), beside.begin(), beside.end());
+  }
+  merge_overlapping(halls);
+  if (!halls.empty())
+    rep.notes.push_back(std::to_string(halls.size()) + (halls.size() == 1 ? " hall" : " halls") +
+                        " (lamps not in rows along the drive)");
+  runs = cut_at_halls(lines, runs, halls, o.min_stretch_m);
+
   // 2. Places: where runs of two lines meet, and where a run ends with nothing there.
   std::vector<Place> places;
   auto add_place = [&](const Vector2d& p) {
@@ -156,7 +165,10 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
         return;
       }
     }
-    places.push_back({p, 1, {}, graph::Place::junction, -1});
+    Place q;
+    q.point = p;
+    q.members = 1;
+    places.push_back(q);
   };
   for (std::size_t i = 0; i < runs.size(); ++i) {
     for (std::size_t j = i + 1; j < runs.size(); ++j) {
@@ -173,8 +185,8 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     }
   }
   for (const auto& r : runs) {
-    add_place(lines[r.line].at(r.s0));
-    add_place(lines[r.line].at(r.s1));
+    if (r.hall0 < 0) add_place(lines[r.line].at(r.s0));
+    if (r.hall1 < 0) add_place(lines[r.line].at(r.s1));
   }
   // Ways out of each place: the runs that go on from it by more than a place's size.
   // Where a point lies along a run (the distance along its line), if the run passes it.
@@ -192,15 +204,28 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
   };
   std::vector<Place> kept;
   for (auto& q : places) {
+    bool in_hall = false;
+    for (const auto& h : halls) in_hall = in_hall || h.contains(q.point);
+    if (in_hall) continue;
+    auto add_way = [&](const Vector2d& way) {
+      bool known = false;
+      for (const auto& v : q.ways) known = known || v.dot(way) > std::cos(20 * M_PI / 180);
+      if (!known) q.ways.push_back(way);
+    };
     for (const auto& [r, s] : runs_through(q)) {
       const Vector2d d = lines[r->line].dir;
       for (const Vector2d& way : {Vector2d(d), Vector2d(-d)}) {
-        const bool goes_on = way.dot(d) > 0 ? r->s1 - s > near : s - r->s0 > near;
-        if (!goes_on) continue;
-        bool known = false;
-        for (const auto& v : q.ways) known = known || v.dot(way) > std::cos(20 * M_PI / 180);
-        if (!known) q.ways.push_back(way);
+        const bool ahead = way.dot(d) > 0;
+        const bool goes_on =
+            ahead ? r->s1 - s > near || r->hall1 >= 0 : s - r->s0 > near || r->hall0 >= 0;
+        if (goes_on) add_way(way);
       }
+    }
+    for (std::size_t h = 0; h < halls.size(); ++h) {
+      const Vector2d to = nearest_on(halls[h], q.point) - q.point;
+      if (to.norm() > near) continue;
+      add_way(to.normalized());  // into the hall next to it
+      q.beside.push_back(static_cast<int>(h));
     }
     const std::size_t n = q.ways.size();
     if (n == 2 && q.ways[0].dot(q.ways[1]) < -std::cos(20 * M_PI / 180)) continue;  // straight on
@@ -208,11 +233,26 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     kept.push_back(q);
   }
   places = std::move(kept);
+  // The halls are places too, after the others.
+  const int first_hall = static_cast<int>(places.size());
+  for (std::size_t h = 0; h < halls.size(); ++h) {
+    Place q;
+    q.kind = graph::Place::hall;
+    q.hall = static_cast<int>(h);
+    q.region = halls[h];
+    q.point = halls[h].centroid();
+    places.push_back(q);
+  }
 
   // When the drive first came near a point: places and corridors are numbered in that order.
   auto first_reached = [&](const Vector2d& p) {
     for (std::size_t k = 0; k < pts.size(); ++k)
       if ((pts[k] - p).norm() < near) return k;
+    return pts.size();
+  };
+  auto first_inside = [&](const graph::Polygon& region) {
+    for (std::size_t k = 0; k < pts.size(); ++k)
+      if (region.contains(pts[k])) return k;
     return pts.size();
   };
 
@@ -222,18 +262,30 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     int from, to;   // places
   };
   std::vector<Corridor> corridors;
+  std::set<std::pair<int, int>> links;  // places linked directly (a place and a hall beside it)
+  for (int i = 0; i < first_hall; ++i)
+    for (const int h : places[i].beside) links.insert({i, first_hall + h});
   for (const auto& r : runs) {
     const Line& L = lines[r.line];
     std::vector<std::pair<double, int>> on;
-    for (std::size_t i = 0; i < places.size(); ++i)
-      if (const auto s = along_run(r, places[i].point)) on.emplace_back(*s, static_cast<int>(i));
+    for (int i = 0; i < first_hall; ++i)
+      if (const auto s = along_run(r, places[i].point)) on.emplace_back(*s, i);
+    if (r.hall0 >= 0) on.emplace_back(r.s0, first_hall + r.hall0);
+    if (r.hall1 >= 0) on.emplace_back(r.s1, first_hall + r.hall1);
     std::sort(on.begin(), on.end());
     for (std::size_t k = 1; k < on.size(); ++k) {
-      const double len = on[k].first - on[k - 1].first;
-      if (len < w + 0.5) continue;
-      // Along the line itself, from one place's square to the next one's.
-      corridors.push_back({L.at(on[k - 1].first + w / 2), L.at(on[k].first - w / 2),
-                           on[k - 1].second, on[k].second});
+      const auto [s0, p0] = on[k - 1];
+      const auto [s1, p1] = on[k];
+      if (p0 == p1) continue;
+      // Along the line itself, from one place's square to the next one's (a hall's edge).
+      const double a = s0 + (places[p0].hall < 0 ? w / 2 : 0);
+      const double b = s1 - (places[p1].hall < 0 ? w / 2 : 0);
+      if (b - a < 0.5) {
+        if (places[p0].hall >= 0 || places[p1].hall >= 0) links.insert({p0, p1});
+        continue;
+      }
+      if (s1 - s0 < w + 0.5) continue;
+      corridors.push_back({L.at(a), L.at(b), p0, p1});
     }
   }
 
@@ -245,7 +297,9 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
   };
   std::vector<Pending> order;
   for (std::size_t i = 0; i < places.size(); ++i)
-    order.push_back({first_reached(places[i].point), false, static_cast<int>(i)});
+    order.push_back(
+        {places[i].hall >= 0 ? first_inside(places[i].region) : first_reached(places[i].point),
+         false, static_cast<int>(i)});
   for (std::size_t i = 0; i < corridors.size(); ++i)
     order.push_back(
         {first_reached(0.5 * (corridors[i].a + corridors[i].b)), true, static_cast<int>(i)});
@@ -267,6 +321,13 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
       n.region = rectangle(c.a, c.b, w);
       letter = 'C';
       corridor_node[p.index] = static_cast<int>(nodes.size());
+    } else if (places[p.index].hall >= 0) {
+      Place& q = places[p.index];
+      n.place = graph::Place::hall;
+      n.region = q.region;
+      n.point = q.point;
+      letter = 'H';
+      q.node = static_cast<int>(nodes.size());
     } else {
       Place& q = places[p.index];
       n.place = q.kind;
@@ -311,6 +372,29 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
       n.point = 0.5 * (ax.first + ax.second);
       return true;
     }
+    if (n.place == graph::Place::hall) {
+      // Cut along the other's edge that leaves the most of the hall's lamps, then of its area
+      // (both regions are convex).
+      std::vector<Vector2d> v = other.region.vertices();
+      if (other.region.signed_area() < 0) std::reverse(v.begin(), v.end());
+      graph::Polygon best;
+      std::pair<int, double> best_score(-1, 0.0);
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        graph::Polygon cut = graph::clip_left_of(n.region, v[(i + 1) % v.size()], v[i]);
+        if (cut.size() < 3) continue;
+        int held = 0;
+        for (const auto& l : mapped.lamps) held += cut.contains(l.xyz.head<2>(), 1e-6);
+        const std::pair<int, double> score(held, cut.area());
+        if (score > best_score) {
+          best_score = score;
+          best = std::move(cut);
+        }
+      }
+      if (best.size() < 3 || best.area() < 0.25) return false;
+      n.region = best;
+      n.point = best.centroid();
+      return true;
+    }
     std::vector<Vector2d> smaller;
     for (const auto& p : n.region.vertices()) smaller.push_back(n.point + 0.9 * (p - n.point));
     n.region = graph::Polygon(smaller);
@@ -320,8 +404,10 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     for (std::size_t a = 0; a < b; ++a) {
       if (dropped[a] || dropped[b]) continue;
       for (int step = 0; step < 40 && overlap(a, b) > allowed; ++step) {
-        // The one to give way: a corridor before a place, else the later one.
-        const std::size_t g = nodes[b].axis || !nodes[a].axis ? b : a;
+        // The one to give way: a hall (cut along the other's edge), then a corridor
+        // (shortened), else the later one.
+        const auto hall = [&](std::size_t i) { return nodes[i].place == graph::Place::hall; };
+        const std::size_t g = hall(b) ? b : hall(a) ? a : nodes[b].axis ? b : nodes[a].axis ? a : b;
         if (!give_way(nodes[g], nodes[g == b ? a : b])) {
           dropped[g] = true;
           break;
@@ -334,6 +420,43 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     rep.notes.push_back(std::to_string(left_out) +
                         " places were left out: their regions would overlap others (the drive "
                         "met them at an angle)");
+
+  // A drive all in one hall has no way between places, which a map must have (Nav2 loads no
+  // graph without an edge): the hall is cut in two across its longest extent, the halves linked.
+  std::vector<std::pair<std::size_t, std::size_t>> node_links;
+  std::vector<std::size_t> live;
+  for (std::size_t i = 0; i < nodes.size(); ++i)
+    if (!dropped[i]) live.push_back(i);
+  if (live.size() == 1 && nodes[live[0]].place == graph::Place::hall) {
+    const graph::Node whole = nodes[live[0]];
+    const auto& v = whole.region.vertices();
+    Vector2d d(1, 0);
+    double longest = 0;
+    for (const auto& p : v)
+      for (const auto& q : v)
+        if ((q - p).norm() > longest) {
+          longest = (q - p).norm();
+          d = (q - p) / longest;
+        }
+    const Vector2d c = whole.region.centroid(), n(-d.y(), d.x());
+    graph::Node first = whole, second = whole;
+    first.region = graph::clip_left_of(whole.region, c + n, c);
+    second.region = graph::clip_left_of(whole.region, c, c + n);
+    first.point = first.region.centroid();
+    second.point = second.region.centroid();
+    second.id = NodeId(static_cast<std::int64_t>(nodes.size()) + 1);
+    second.name = "H" + std::to_string(++counters['H']);
+    for (const auto& nm : names)
+      if (second.region.contains(nm.at)) second.name = nm.name;
+    nodes[live[0]] = first;
+    nodes.push_back(second);
+    dropped.push_back(false);
+    node_links.emplace_back(live[0], nodes.size() - 1);
+    rep.notes.push_back(
+        "the drive was all in one hall: it is cut in two halves across its length, " + first.name +
+        " and " + second.name +
+        ", so that the map has a way between places (merge or rename them by hand)");
+  }
 
   // 5. Lamps into the place whose region holds them, in walking order.
   std::vector<std::vector<const MappedLamp*>> held(nodes.size());
@@ -371,29 +494,33 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
   for (std::size_t i = 0; i < nodes.size(); ++i)
     if (!dropped[i]) map.add_node(nodes[i]);
 
-  // 6. Edges: each corridor to the places at its ends, both ways.
+  // 6. Edges: each corridor to the places at its ends, and each hall to the places beside it,
+  // both ways.
   std::int64_t next_edge = 1000;
+  auto link = [&](const graph::Node& a, const graph::Node& b) {
+    for (const auto& [s, e] : {std::pair{&a, &b}, std::pair{&b, &a}}) {
+      graph::Edge edge;
+      edge.id = EdgeId(next_edge++);
+      edge.start = s->id;
+      edge.end = e->id;
+      edge.geometry = {{s->point, e->point}};
+      edge.cost = (e->point - s->point).norm();
+      map.add_edge(edge);
+    }
+  };
   for (std::size_t i = 0; i < corridors.size(); ++i) {
     if (dropped[corridor_node[i]]) continue;
-    const graph::Node& c = nodes[corridor_node[i]];
-    for (const int pl : {corridors[i].from, corridors[i].to}) {
-      if (dropped[places[pl].node]) continue;
-      const graph::Node& q = nodes[places[pl].node];
-      for (const auto& [s, e] : {std::pair{&c, &q}, std::pair{&q, &c}}) {
-        graph::Edge edge;
-        edge.id = EdgeId(next_edge++);
-        edge.start = s->id;
-        edge.end = e->id;
-        edge.geometry = {{s->point, e->point}};
-        edge.cost = (e->point - s->point).norm();
-        map.add_edge(edge);
-      }
-    }
+    for (const int pl : {corridors[i].from, corridors[i].to})
+      if (!dropped[places[pl].node]) link(nodes[corridor_node[i]], nodes[places[pl].node]);
   }
+  for (const auto& [p, q] : links)
+    if (!dropped[places[p].node] && !dropped[places[q].node])
+      link(nodes[places[p].node], nodes[places[q].node]);
+  for (const auto& [a, b] : node_links) link(nodes[a], nodes[b]);
   if (rep.lamps_outside)
     rep.notes.push_back(std::to_string(rep.lamps_outside) +
-                        " lamps lie in no corridor or place the drive went through (rooms, "
-                        "halls): left out");
+                        " lamps lie in no corridor, place or hall the drive went through "
+                        "(rooms, halls seen from one lane): left out");
   if (report) *report = rep;
   return map;
 }

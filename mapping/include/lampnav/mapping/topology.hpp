@@ -4,8 +4,11 @@
 // stretches make corridor lines; where lines meet are places, their kind by the ways out the
 // drive took (one: an end, two at an angle: a corner, three or more: a junction); the pieces of
 // the lines between places are corridors. Each lamp goes to the place whose region holds it, in
-// walking order. What the drive never went down is not in the map: a junction whose third way
-// was never driven comes out a corner.
+// walking order. Halls are where the drive went up and down beside itself (parallel stretches
+// closer than a corridor's width cannot be two corridors) over lamps spread across its lanes, and
+// where it saw lamps off to its side in no corridor's row: their region is the lanes and the
+// lamps, and the places and corridors around link to them. What the drive never went down is not in
+// the map: a junction whose third way was never driven comes out a corner.
 
 #include <map>
 #include <string>
@@ -22,8 +25,23 @@ struct TopologyOptions {
   double min_stretch_m = 1.0;     // shorter straight stretches (turns on the spot) are dropped
   double same_line_m = 0.6;       // stretches this close across and parallel share a line
   double parallel_deg = 8.0;
-  double gap_m = 1.5;     // a line's stretches this far apart are one corridor
-  double place_m = 1.5;   // line meetings this close are one place
+  double gap_m = 1.5;    // a line's stretches this far apart are one corridor
+  double place_m = 1.5;  // line meetings this close are one place
+  // Halls: stretches side by side over hall_min_overlap_m (longer than the turn from one lane to
+  // the next, which is itself a stretch), further apart than same_line_m and at most
+  // hall_lane_gap_m (0: no halls), with the lamps around them in rows along them
+  // hall_min_spread_m apart (one row is a corridor driven twice, once on each side).
+  double hall_lane_gap_m = 3.0;
+  double hall_min_overlap_m = 4.0;
+  double hall_min_spread_m = 1.5;
+  double hall_margin_m = 0.5;  // a hall's region: its lanes and lamps, and this much around them
+  // Halls seen from one lane: at least hall_min_lamps lamps (0: none) beside the drive, in no
+  // corridor's band, each within hall_link_m of another, or within hall_link_per_height times
+  // their height above the floor (lamps hung higher are further apart: lighting designs keep
+  // spacing within about 1.5 times the mounting height).
+  int hall_min_lamps = 3;
+  double hall_link_m = 6.0;
+  double hall_link_per_height = 1.5;
   void validate() const;  // throws InputError naming the field
 };
 
