@@ -235,7 +235,7 @@ struct EvaluationScratch {
   std::vector<Predicted> pred;
   std::vector<Pair> pairs, taken, left;
   std::vector<char> explained, b_used;
-  std::vector<double> blob_term;
+  std::vector<double> blob_term, nearest;
   std::vector<int> first_of_lamp, first_of_blob;
   detail::RayGrid grid;
 };
@@ -288,6 +288,8 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
   explained.assign(blobs.size(), 0);
   std::vector<double>& blob_term = x.blob_term;
   blob_term.resize(blobs.size());
+  std::vector<double>& nearest = x.nearest;  // each blob's least d2 to a lamp (explained ones)
+  nearest.assign(blobs.size(), 9.0);
   for (std::size_t j = 0; j < blobs.size(); ++j)
     blob_term[j] = 0.25 * blobs[j].angular_radius * blobs[j].angular_radius;
   detail::RayGrid& near = x.grid;
@@ -301,6 +303,7 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
       const double d2 = chord2 / s2;
       if (d2 <= 9.0) {
         explained[j] = 1;
+        nearest[j] = std::min(nearest[j], d2);
         if (pred[i].z >= cos_max) pairs.push_back({d2, int(i), int(j)});
       }
     });
@@ -348,10 +351,17 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
   Evaluation e;
   e.cost = 0;
   e.matches.reserve(taken.size());
+  // Blobs in clear view cost their match. Past it, where lamps may go unmatched at no cost
+  // (hidden, merged with a neighbour's bloom near the horizon), each blob costs its distance to
+  // the nearest lamp, matched or not. Were only the matches to cost there, a place whose far view
+  // matched fewer blobs would cost less: under a 4 m ceiling, with 200 blobs a frame, a twin 40 m
+  // off matched 50 fewer than the truth and cost 2 to 4 less a frame.
   for (const Pair& p : taken) {
-    e.cost += p.cost;
+    if (blobs[p.b].ray.z() >= cos_expect) e.cost += p.cost;
     e.matches.emplace_back(pred[p.p].lamp, p.b);
   }
+  for (std::size_t j = 0; j < blobs.size(); ++j)
+    if (explained[j] && blobs[j].ray.z() < cos_expect) e.cost += nearest[j];
   // A lamp in clear view is missing when no blob matched it; one crowded by its neighbours only
   // when no blob lies over it either: within the lamp's size and cover_sigmas of its direction's
   // sigma, widened by the blob's own size (a merged blob spans its lamps). Lamps whose blobs may

@@ -62,9 +62,12 @@ struct LampPairOptions {
   // or the first lamp of a side corridor falls outside it, and every corridor of a regular building
   // looks the same to the screen.
   double screen_max_theta_deg = 80.0;
-  double max_theta_deg = 88.0;         // lamps and blobs used to score a pose
-  double expect_max_theta_deg = 80.0;  // a lamp further off-axis may be missed without cost
-  double detection_sigma_deg = 0.1;    // a blob's direction
+  double max_theta_deg = 88.0;  // lamps and blobs used to score a pose
+  // A lamp further off-axis may be missed without cost; a blob there costs its distance to the
+  // nearest lamp, matched one to one or not (a far view's cost must not fall as a place matches
+  // fewer of its blobs, or a twin matching fewer is the likelier).
+  double expect_max_theta_deg = 80.0;
+  double detection_sigma_deg = 0.1;  // a blob's direction
   // In enumerate(), a seed's lamp may be off where its blob's centroid puts it by this
   // fraction of the lamp's length times the sine of its angle off the zenith (a long lamp seen
   // obliquely).
