@@ -224,7 +224,7 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     for (std::size_t h = 0; h < halls.size(); ++h) {
       const Vector2d to = nearest_on(halls[h], q.point) - q.point;
       if (to.norm() > near) continue;
-      add_way(to.normalized());  // into the hall next to it
+      if (to.norm() > 1e-6) add_way(to.normalized());  // into the hall next to it
       q.beside.push_back(static_cast<int>(h));
     }
     const std::size_t n = q.ways.size();
@@ -427,7 +427,8 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
   std::vector<std::size_t> live;
   for (std::size_t i = 0; i < nodes.size(); ++i)
     if (!dropped[i]) live.push_back(i);
-  if (live.size() == 1 && nodes[live[0]].place == graph::Place::hall) {
+  if (live.size() == 1 && nodes[live[0]].place == graph::Place::hall &&
+      nodes[live[0]].region.area() >= 1.0) {
     const graph::Node whole = nodes[live[0]];
     const auto& v = whole.region.vertices();
     Vector2d d(1, 0);
