@@ -16,31 +16,28 @@ bool on_segment(const Vector2d& a, const Vector2d& b, const Vector2d& p) {
   return std::min(a.x(), b.x()) <= p.x() && p.x() <= std::max(a.x(), b.x()) &&
          std::min(a.y(), b.y()) <= p.y() && p.y() <= std::max(a.y(), b.y());
 }
-double point_segment_distance(const Vector2d& p, const Vector2d& a, const Vector2d& b) {
-  const Vector2d ab = b - a;
-  const double len2 = ab.squaredNorm();
-  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
+// The part of the convex polygon `v` left of the directed line a -> b (Sutherland-Hodgman, one
+// edge): the vertices on or left of it, and where its edges cross it.
+std::vector<Vector2d> clip_left(const std::vector<Vector2d>& v, const Vector2d& a,
+                                const Vector2d& b) {
+  std::vector<Vector2d> out;
+  out.reserve(v.size() + 2);
+  for (std::size_t j = 0; j < v.size(); ++j) {
+    const Vector2d& p = v[j];
+    const Vector2d& q = v[(j + 1) % v.size()];
+    const double dp = orient(a, b, p), dq = orient(a, b, q);
+    if (dp >= 0) out.push_back(p);
+    if ((dp > 0 && dq < 0) || (dp < 0 && dq > 0)) out.push_back(p + (q - p) * (dp / (dp - dq)));
+  }
+  return out;
 }
 
-// Clips convex polygon `subject` by the convex counter-clockwise polygon `clip`
-// (Sutherland-Hodgman), returning the area of what is left.
+// Clips convex polygon `subject` by the convex counter-clockwise polygon `clip`, returning the
+// area of what is left.
 double convex_intersection_area(std::vector<Vector2d> subject,
                                 const std::array<Vector2d, 3>& clip) {
-  for (std::size_t i = 0; i < 3 && !subject.empty(); ++i) {
-    const Vector2d& a = clip[i];
-    const Vector2d& b = clip[(i + 1) % 3];
-    std::vector<Vector2d> out;
-    out.reserve(subject.size() + 2);
-    for (std::size_t j = 0; j < subject.size(); ++j) {
-      const Vector2d& p = subject[j];
-      const Vector2d& q = subject[(j + 1) % subject.size()];
-      const double dp = orient(a, b, p), dq = orient(a, b, q);
-      if (dp >= 0) out.push_back(p);
-      if ((dp >= 0) != (dq >= 0)) out.push_back(p + (q - p) * (dp / (dp - dq)));
-    }
-    subject = std::move(out);
-  }
+  for (std::size_t i = 0; i < 3 && !subject.empty(); ++i)
+    subject = clip_left(subject, clip[i], clip[(i + 1) % 3]);
   if (subject.size() < 3) return 0.0;
   double a2 = 0;
   for (std::size_t j = 0; j < subject.size(); ++j)
@@ -92,12 +89,32 @@ Vector2d Polygon::centroid() const {
   return c / (6.0 * a);
 }
 
-double Polygon::distance_to_boundary(const Vector2d& p) const {
-  double d = INFINITY;
+Vector2d Polygon::nearest_on_boundary(const Vector2d& p) const {
+  Vector2d best = v_.empty() ? p : v_.front();
   for (std::size_t i = 0; i < v_.size(); ++i) {
-    d = std::min(d, point_segment_distance(p, v_[i], v_[(i + 1) % v_.size()]));
+    const Vector2d q = closest_on_segment(p, v_[i], v_[(i + 1) % v_.size()]);
+    if ((q - p).squaredNorm() < (best - p).squaredNorm()) best = q;
   }
-  return d;
+  return best;
+}
+
+double Polygon::distance_to_boundary(const Vector2d& p) const {
+  return v_.empty() ? INFINITY : (nearest_on_boundary(p) - p).norm();
+}
+
+Vector2d closest_on_segment(const Vector2d& p, const Vector2d& a, const Vector2d& b) {
+  const Vector2d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return a + t * ab;
+}
+
+double segment_distance(const Vector2d& a, const Vector2d& b, const Vector2d& c,
+                        const Vector2d& d) {
+  if (segments_intersect(a, b, c, d)) return 0;
+  return std::min(
+      {(closest_on_segment(a, c, d) - a).norm(), (closest_on_segment(b, c, d) - b).norm(),
+       (closest_on_segment(c, a, b) - c).norm(), (closest_on_segment(d, a, b) - d).norm()});
 }
 
 bool Polygon::contains(const Vector2d& p, double tolerance) const {
@@ -226,16 +243,7 @@ Polygon convex_hull(std::vector<Vector2d> pts) {
 }
 
 Polygon clip_left_of(const Polygon& convex, const Vector2d& a, const Vector2d& b) {
-  const auto& v = convex.vertices();
-  std::vector<Vector2d> out;
-  for (std::size_t j = 0; j < v.size(); ++j) {
-    const Vector2d& p = v[j];
-    const Vector2d& q = v[(j + 1) % v.size()];
-    const double dp = orient(a, b, p), dq = orient(a, b, q);
-    if (dp >= 0) out.push_back(p);
-    if ((dp > 0 && dq < 0) || (dp < 0 && dq > 0)) out.push_back(p + (q - p) * (dp / (dp - dq)));
-  }
-  return Polygon(std::move(out));
+  return Polygon(clip_left(convex.vertices(), a, b));
 }
 
 double signed_angle(const Vector2d& a, const Vector2d& b) {

@@ -20,18 +20,6 @@ graph::Polygon grown_hull(const std::vector<Vector2d>& pts, double r) {
   return graph::convex_hull(around);
 }
 
-double segment_distance(const Vector2d& a, const Vector2d& b, const Vector2d& c,
-                        const Vector2d& d) {
-  if (graph::segments_intersect(a, b, c, d)) return 0;
-  auto to = [](const Vector2d& p, const Vector2d& x, const Vector2d& y) {
-    const Vector2d e = y - x;
-    const double t =
-        e.squaredNorm() > 0 ? std::clamp((p - x).dot(e) / e.squaredNorm(), 0.0, 1.0) : 0.0;
-    return (x + t * e - p).norm();
-  };
-  return std::min({to(a, c, d), to(b, c, d), to(c, a, b), to(d, a, b)});
-}
-
 // The connected components of n items linked pairwise by `linked` (single linkage): each item's
 // component, named by one of its items.
 template <typename Linked>
@@ -101,8 +89,8 @@ std::vector<graph::Polygon> halls_from_lanes(const std::vector<Line>& lines,
     }
   // Lanes that touch (a pair's two, and lanes of pairs that share a stretch) are one group.
   const auto root = components(lanes.size(), [&](std::size_t i, std::size_t j) {
-    return segment_distance(lanes[i].first, lanes[i].second, lanes[j].first, lanes[j].second) <=
-           o.hall_lane_gap_m;
+    return graph::segment_distance(lanes[i].first, lanes[i].second, lanes[j].first,
+                                   lanes[j].second) <= o.hall_lane_gap_m;
   });
   std::vector<std::vector<Vector2d>> members;
   std::map<std::size_t, std::size_t> index;
@@ -258,18 +246,6 @@ std::vector<Run> cut_at_halls(const std::vector<Line>& lines, const std::vector<
       if (p.s1 - p.s0 >= min_length) out.push_back(p);
   }
   return out;
-}
-
-// The point of a polygon's boundary nearest p.
-Vector2d nearest_on(const graph::Polygon& P, const Vector2d& p) {
-  const auto& v = P.vertices();
-  Vector2d best = v.front();
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    const Vector2d a = v[i], e = v[(i + 1) % v.size()] - a;
-    const double t = std::clamp((p - a).dot(e) / std::max(e.squaredNorm(), 1e-18), 0.0, 1.0);
-    if ((a + t * e - p).norm() < (best - p).norm()) best = a + t * e;
-  }
-  return best;
 }
 
 }  // namespace lampnav::mapping::drive_topology

@@ -56,7 +56,4 @@ void merge_overlapping(std::vector<graph::Polygon>& halls);
 std::vector<Run> cut_at_halls(const std::vector<Line>& lines, const std::vector<Run>& runs,
                               const std::vector<graph::Polygon>& halls, double min_length);
 
-// The point of a polygon's boundary nearest p.
-Eigen::Vector2d nearest_on(const graph::Polygon& P, const Eigen::Vector2d& p);
-
 }  // namespace lampnav::mapping::drive_topology

@@ -222,7 +222,7 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
       }
     }
     for (std::size_t h = 0; h < halls.size(); ++h) {
-      const Vector2d to = nearest_on(halls[h], q.point) - q.point;
+      const Vector2d to = halls[h].nearest_on_boundary(q.point) - q.point;
       if (to.norm() > near) continue;
       if (to.norm() > 1e-6) add_way(to.normalized());  // into the hall next to it
       q.beside.push_back(static_cast<int>(h));

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 #include "lampnav/graph/geometry.hpp"
@@ -93,6 +94,18 @@ TEST(ConvexHull, HoldsEveryPointAndIsConvex) {
   const Polygon sq = convex_hull({{0, 0}, {2, 0}, {1, 1}, {2, 2}, {0, 2}, {1, 0}});
   EXPECT_EQ(sq.size(), 4u);
   EXPECT_DOUBLE_EQ(sq.area(), 4.0);
+}
+
+TEST(Segments, NearestPointsAndDistance) {
+  EXPECT_LT((closest_on_segment(V(1, 1), V(0, 0), V(2, 0)) - V(1, 0)).norm(), 1e-12);
+  EXPECT_LT((closest_on_segment(V(5, 1), V(0, 0), V(2, 0)) - V(2, 0)).norm(), 1e-12);
+  EXPECT_DOUBLE_EQ(segment_distance(V(0, 0), V(2, 0), V(1, -1), V(1, 1)), 0.0);  // crossing
+  EXPECT_DOUBLE_EQ(segment_distance(V(0, 0), V(2, 0), V(0, 3), V(2, 3)), 3.0);   // parallel
+  EXPECT_DOUBLE_EQ(segment_distance(V(0, 0), V(2, 0), V(3, 1), V(5, 1)), std::sqrt(2.0));
+  const Polygon sq = square(0, 0, 2);
+  EXPECT_LT((sq.nearest_on_boundary(V(1, 1.5)) - V(1, 2)).norm(), 1e-12);
+  EXPECT_LT((sq.nearest_on_boundary(V(3, 3)) - V(2, 2)).norm(), 1e-12);
+  EXPECT_DOUBLE_EQ(sq.distance_to_boundary(V(1, 1.5)), 0.5);
 }
 
 TEST(ClipLeftOf, KeepsTheLeftSide) {

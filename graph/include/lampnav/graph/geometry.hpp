@@ -29,6 +29,8 @@ class Polygon {
   // Points on the boundary (within `tolerance`) count as inside.
   bool contains(const Eigen::Vector2d& p, double tolerance = 1e-9) const;
   double distance_to_boundary(const Eigen::Vector2d& p) const;
+  // The point of the boundary nearest p (p itself for a polygon with no vertices).
+  Eigen::Vector2d nearest_on_boundary(const Eigen::Vector2d& p) const;
   // True when two non-adjacent edges touch or cross, or two adjacent edges fold back on each other.
   bool self_intersects() const;
   // Triangles (counter-clockwise) covering the polygon exactly, by ear clipping.
@@ -51,6 +53,14 @@ Polygon clip_left_of(const Polygon& convex, const Eigen::Vector2d& a, const Eige
 
 // Signed angle from direction a to direction b, in (-pi, pi]; positive is a left (CCW) turn.
 double signed_angle(const Eigen::Vector2d& a, const Eigen::Vector2d& b);
+
+// The point of segment a-b nearest p.
+Eigen::Vector2d closest_on_segment(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
+                                   const Eigen::Vector2d& b);
+
+// The distance between closed segments a-b and c-d (0 when they share a point).
+double segment_distance(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                        const Eigen::Vector2d& c, const Eigen::Vector2d& d);
 
 // Whether closed segments p1-p2 and q1-q2 share a point.
 bool segments_intersect(const Eigen::Vector2d& p1, const Eigen::Vector2d& p2,
