@@ -97,15 +97,29 @@ TEST(BlobLabeller, SameBlobsAsOpenCvsConnectedComponents) {
 // next_column against its definition, byte by byte: every start, both kinds, rows of 0 to 70
 // pixels (so every tail after the 16-pixel blocks), transitions anywhere.
 TEST(BlobLabeller, NextColumnIsTheFirstPixelOfTheKindAsked) {
+  // Rows of 0 to 200 pixels: scattered bright pixels, or stretches of each kind up to 120 long
+  // (a lamp's inside, the dark between lamps), so that the 64-, 16- and 1-pixel steps all stop at
+  // every place in a block.
   std::mt19937 rng(3);
   int checked = 0;
-  for (int w = 0; w <= 70; ++w) {
-    for (int trial = 0; trial < 20; ++trial) {
+  for (int w = 0; w <= 200; ++w) {
+    for (int trial = 0; trial < 12; ++trial) {
       std::vector<std::uint8_t> row(static_cast<std::size_t>(w) + 1);
-      const int bright_every = 1 + static_cast<int>(rng() % 40);
-      for (auto& p : row)
-        p = rng() % bright_every == 0 ? static_cast<std::uint8_t>(128 + rng() % 128)
-                                      : static_cast<std::uint8_t>(rng() % 128);
+      const auto bright_pixel = [&] { return static_cast<std::uint8_t>(128 + rng() % 128); };
+      const auto dark_pixel = [&] { return static_cast<std::uint8_t>(rng() % 128); };
+      if (trial % 2 == 0) {
+        const int bright_every = 1 + static_cast<int>(rng() % 40);
+        for (auto& p : row) p = rng() % bright_every == 0 ? bright_pixel() : dark_pixel();
+      } else {
+        const int longest = 1 + static_cast<int>(rng() % 120);
+        bool bright = rng() % 2 == 0;
+        for (std::size_t i = 0; i < row.size();) {
+          const std::size_t n = 1 + rng() % longest;
+          for (std::size_t k = 0; k < n && i < row.size(); ++k, ++i)
+            row[i] = bright ? bright_pixel() : dark_pixel();
+          bright = !bright;
+        }
+      }
       for (int u = 0; u <= w; ++u) {
         for (const bool bright : {true, false}) {
           int expected = u;
@@ -117,7 +131,7 @@ TEST(BlobLabeller, NextColumnIsTheFirstPixelOfTheKindAsked) {
       }
     }
   }
-  EXPECT_GT(checked, 100000);
+  EXPECT_GT(checked, 400000);
 }
 
 }  // namespace

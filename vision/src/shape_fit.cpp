@@ -2,97 +2,172 @@
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace lampnav::vision::detail {
 
 using Eigen::Vector2d;
 
-ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Vector2d c,
-                   double theta, double min_drop, std::vector<char>& use) {
+namespace {
+
+// A rectangle's edge points fall in four classes: on an end (|q_x| = a) with q_x >= 0 or < 0, or
+// on a side (|q_y| = b) with q_y >= 0 or < 0, q = R^T (p - c) in the lamp's frame. Within a class
+// the normal equations are polynomials of degree two in the points, so each class keeps the
+// moments of its points (about a fixed origin), and an iteration only has to find which points
+// changed class: after the first, few do.
+enum Class : char { end_pos = 0, end_neg, side_pos, side_neg, dropped, kClasses = dropped };
+
+struct PointMoments {
+  double n = 0, x = 0, y = 0, xx = 0, xy = 0, yy = 0;
+  void add(const Vector2d& p, double k) {
+    n += k, x += k * p.x(), y += k * p.y();
+    xx += k * p.x() * p.x(), xy += k * p.x() * p.y(), yy += k * p.y() * p.y();
+  }
+};
+
+// The class of a point: the nearer of end and side, and the sign of that coordinate; `r` its
+// distance to the shape (signed: outside > 0). Without branches: ends and sides alternate along
+// the edge points, and a mispredicted branch would cost more than the arithmetic.
+Class classify(double qx, double qy, double a, double b, double& r) {
+  const double rx = std::fabs(qx) - a, ry = std::fabs(qy) - b;
+  const int end = std::fabs(rx) < std::fabs(ry);
+  r = end ? rx : ry;
+  return static_cast<Class>(end ? int(qx < 0) : 2 + int(qy < 0));
+}
+
+ShapeFit fit_rectangle(const EdgePoints& pts, double a, double b, Vector2d c, double theta,
+                       double min_drop, std::vector<char>& cls) {
   ShapeFit fit;
-  use.assign(pts.size(), 1);
+  // Moments about the first centre, where the points are: small numbers, no cancellation.
+  const Vector2d origin = c;
+  std::array<PointMoments, kClasses> m{};
+  cls.assign(pts.size(), dropped);
+  bool first = true;
   double rms = 0;
   // Points are dropped once the fit has settled on all of them (a step below the tolerance, or
   // after three iterations), and the fit ends when it settles again with the points it keeps.
   bool dropping = false;
   for (int it = 0; it < 20; ++it) {
-    // The normal equations J^T J (symmetric: six sums) and J^T r.
-    double h00 = 0, h01 = 0, h02 = 0, h11 = 0, h12 = 0, h22 = 0, g0 = 0, g1 = 0, g2 = 0;
     const double cs = std::cos(theta), sn = std::sin(theta);
-    double sum2 = 0;
-    int n = 0, ends = 0, sides = 0;
     const double drop = dropping ? std::max(min_drop, 3.0 * rms) : HUGE_VAL;
-    if (rectangle) {
-      // In the lamp's frame q = R^T (p - c), a point is on an end (|q_x| = a) or a side
-      // (|q_y| = b), whichever is nearer; s is the sign of that coordinate. dq/dc = -R^T and
-      // dq/dtheta = (q_y, -q_x), so an end's Jacobian row is s (-cos, -sin, q_y) and a side's
-      // s (sin, -cos, -q_x): each class adds to J^T J a fixed part times its count plus its sums
-      // of q and q^2, and to J^T r its sums of s r and s r q. Without branches, point by point.
-      double n_end = 0, q_end = 0, qq_end = 0, sr_end = 0, srq_end = 0;
-      double n_side = 0, q_side = 0, qq_side = 0, sr_side = 0, srq_side = 0;
-      for (std::size_t i = 0; i < pts.size(); ++i) {
-        const double dx = pts[i].x() - c.x(), dy = pts[i].y() - c.y();
-        const double qx = cs * dx + sn * dy, qy = -sn * dx + cs * dy;
-        const double rx = std::fabs(qx) - a, ry = std::fabs(qy) - b;
-        const bool end = std::fabs(rx) < std::fabs(ry);
-        const double r = end ? rx : ry;
-        // Once dropped, a point stays dropped.
-        const bool kept = use[i] && std::fabs(r) <= drop;
-        use[i] = kept;
-        const double we = kept && end ? 1.0 : 0.0, ws = kept && !end ? 1.0 : 0.0;
-        const double srx = qx >= 0 ? rx : -rx, sry = qy >= 0 ? ry : -ry;
-        n_end += we, q_end += we * qy, qq_end += we * qy * qy;
-        sr_end += we * srx, srq_end += we * srx * qy;
-        n_side += ws, q_side += ws * qx, qq_side += ws * qx * qx;
-        sr_side += ws * sry, srq_side += ws * sry * qx;
-        sum2 += (we + ws) * r * r;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      if (!first && cls[i] == dropped) continue;  // once dropped, a point stays dropped
+      const Vector2d p = pts[i] - origin;
+      const double dx = pts[i].x() - c.x(), dy = pts[i].y() - c.y();
+      double r;
+      Class k = classify(cs * dx + sn * dy, -sn * dx + cs * dy, a, b, r);
+      if (std::fabs(r) > drop) k = dropped;
+      if (!first && k == cls[i]) continue;
+      if (!first) m[cls[i]].add(p, -1.0);
+      if (k != dropped) m[k].add(p, 1.0);
+      cls[i] = k;
+    }
+    first = false;
+    // Per class: T = sum (p - d) and P = sum (p - d)(p - d)^T, d = c - origin; then the sums of
+    // q_x, q_y and their products follow from e = (cos, sin) and f = (-sin, cos).
+    const Vector2d d = c - origin;
+    const Vector2d e(cs, sn), f(-sn, cs);
+    double n_end = 0, q_end = 0, qq_end = 0, sr_end = 0, srq_end = 0;
+    double n_side = 0, q_side = 0, qq_side = 0, sr_side = 0, srq_side = 0, sum2 = 0;
+    for (int k = 0; k < kClasses; ++k) {
+      const PointMoments& s = m[k];
+      if (s.n <= 0) continue;
+      const Vector2d t(s.x - s.n * d.x(), s.y - s.n * d.y());
+      Eigen::Matrix2d pp;
+      pp(0, 0) = s.xx - 2 * s.x * d.x() + s.n * d.x() * d.x();
+      pp(1, 1) = s.yy - 2 * s.y * d.y() + s.n * d.y() * d.y();
+      pp(0, 1) = pp(1, 0) = s.xy - s.x * d.y() - s.y * d.x() + s.n * d.x() * d.y();
+      const double sx = e.dot(t), sy = f.dot(t);  // sums of q_x and q_y
+      const double sxx = e.dot(pp * e), syy = f.dot(pp * f), sxy = e.dot(pp * f);
+      const double sign = (k == end_pos || k == side_pos) ? 1.0 : -1.0;
+      if (k == end_pos || k == end_neg) {
+        // r = sign q_x - a; the gradient's signed residual sign r = q_x - sign a.
+        n_end += s.n, q_end += sy, qq_end += syy;
+        sr_end += sx - sign * a * s.n, srq_end += sxy - sign * a * sy;
+        sum2 += sxx - 2 * sign * a * sx + a * a * s.n;
+      } else {
+        n_side += s.n, q_side += sx, qq_side += sxx;
+        sr_side += sy - sign * b * s.n, srq_side += sxy - sign * b * sx;
+        sum2 += syy - 2 * sign * b * sy + b * b * s.n;
       }
-      ends = static_cast<int>(n_end);
-      sides = static_cast<int>(n_side);
-      n = ends + sides;
-      h00 = n_end * cs * cs + n_side * sn * sn;
-      h01 = (n_end - n_side) * cs * sn;
-      h11 = n_end * sn * sn + n_side * cs * cs;
-      h02 = -cs * q_end - sn * q_side;
-      h12 = -sn * q_end + cs * q_side;
-      h22 = qq_end + qq_side;
-      g0 = -cs * sr_end + sn * sr_side;
-      g1 = -sn * sr_end - cs * sr_side;
-      g2 = srq_end - srq_side;
-    } else {
-      for (std::size_t i = 0; i < pts.size(); ++i) {
-        if (!use[i]) continue;  // once dropped, a point stays dropped
-        const double dx = pts[i].x() - c.x(), dy = pts[i].y() - c.y();
-        const double dn = std::sqrt(dx * dx + dy * dy);
-        if (dn < 1e-12) continue;
-        const double r = dn - a;
-        if (std::fabs(r) > drop) {
-          use[i] = 0;
-          continue;
-        }
-        const double j0 = -dx / dn, j1 = -dy / dn;
-        h00 += j0 * j0, h01 += j0 * j1, h11 += j1 * j1;
-        g0 += j0 * r, g1 += j1 * r;
-        sum2 += r * r;
-        ++n;
+    }
+    const int ends = static_cast<int>(std::lround(n_end));
+    const int sides = static_cast<int>(std::lround(n_side));
+    const int n = ends + sides;
+    if (n < 12) return fit;
+    rms = std::sqrt(std::max(sum2, 0.0) / n);
+    fit.points = n;
+    fit.rms = rms;
+    // The fit must see an end and a long side, or its position along the lamp (or across it) is
+    // not determined.
+    if (ends < 4 || sides < 8) return fit;
+    // An end's Jacobian row is sign (-cos, -sin, q_y), a side's sign (sin, -cos, -q_x): each class
+    // adds to J^T J a fixed part times its count plus its sums of q and q^2.
+    Eigen::Matrix3d JtJ;
+    JtJ(0, 0) = n_end * cs * cs + n_side * sn * sn;
+    JtJ(0, 1) = JtJ(1, 0) = (n_end - n_side) * cs * sn;
+    JtJ(1, 1) = n_end * sn * sn + n_side * cs * cs;
+    JtJ(0, 2) = JtJ(2, 0) = -cs * q_end - sn * q_side;
+    JtJ(1, 2) = JtJ(2, 1) = -sn * q_end + cs * q_side;
+    JtJ(2, 2) = qq_end + qq_side;
+    const Eigen::Vector3d Jtr(-cs * sr_end + sn * sr_side, -sn * sr_end - cs * sr_side,
+                              srq_end - srq_side);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(JtJ, Eigen::EigenvaluesOnly);
+    if (eig.eigenvalues()(0) < 1e-9 * std::max(1.0, eig.eigenvalues()(2))) return fit;
+    const Eigen::Vector3d step = -JtJ.ldlt().solve(Jtr);
+    c += step.head<2>();
+    theta += step(2);
+    const bool settled = step.head<2>().norm() < 1e-6 && std::fabs(step(2)) < 1e-5;
+    if (settled && dropping) break;
+    dropping = dropping || settled || it >= 2;
+  }
+  fit.centre = c;
+  fit.orientation = theta;
+  fit.ok = true;
+  return fit;
+}
+
+}  // namespace
+
+ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Vector2d c,
+                   double theta, double min_drop, std::vector<char>& use) {
+  if (rectangle) return fit_rectangle(pts, a, b, c, theta, min_drop, use);
+  // A disc: its distance to a point needs the point's own square root, so it is summed point by
+  // point. Its heading is pinned (unit information, zero gradient) and the same 3x3 solved.
+  ShapeFit fit;
+  use.assign(pts.size(), 1);
+  double rms = 0;
+  bool dropping = false;
+  for (int it = 0; it < 20; ++it) {
+    double h00 = 0, h01 = 0, h11 = 0, g0 = 0, g1 = 0, sum2 = 0;
+    int n = 0;
+    const double drop = dropping ? std::max(min_drop, 3.0 * rms) : HUGE_VAL;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      if (!use[i]) continue;  // once dropped, a point stays dropped
+      const double dx = pts[i].x() - c.x(), dy = pts[i].y() - c.y();
+      const double dn = std::sqrt(dx * dx + dy * dy);
+      if (dn < 1e-12) continue;
+      const double r = dn - a;
+      if (std::fabs(r) > drop) {
+        use[i] = 0;
+        continue;
       }
+      const double j0 = -dx / dn, j1 = -dy / dn;
+      h00 += j0 * j0, h01 += j0 * j1, h11 += j1 * j1;
+      g0 += j0 * r, g1 += j1 * r;
+      sum2 += r * r;
+      ++n;
     }
     if (n < 12) return fit;
     rms = std::sqrt(sum2 / n);
     fit.points = n;
     fit.rms = rms;
-    // The fit must see an end and a long side of a rectangle, or its position along the lamp
-    // (or across it) is not determined.
-    if (rectangle && (ends < 4 || sides < 8)) return fit;
     Eigen::Matrix3d JtJ;
-    JtJ << h00, h01, h02, h01, h11, h12, h02, h12, h22;
-    const Eigen::Vector3d Jtr(g0, g1, g2);
-    // A disc has no heading: pin it (unit information, zero gradient) and solve the same 3x3.
-    if (!rectangle) JtJ(2, 2) = 1.0;
+    JtJ << h00, h01, 0, h01, h11, 0, 0, 0, 1.0;
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(JtJ, Eigen::EigenvaluesOnly);
     if (eig.eigenvalues()(0) < 1e-9 * std::max(1.0, eig.eigenvalues()(2))) return fit;
-    const Eigen::Vector3d step = -JtJ.ldlt().solve(Jtr);
+    const Eigen::Vector3d step = -JtJ.ldlt().solve(Eigen::Vector3d(g0, g1, 0));
     c += step.head<2>();
     theta += step(2);
     const bool settled = step.head<2>().norm() < 1e-6 && std::fabs(step(2)) < 1e-5;

@@ -21,9 +21,11 @@ struct ShapeFit {
 // Gauss-Newton fit of a rectangle (half sizes a >= b, normalized units) or a disc (radius a) of
 // known size to edge points, from one initial centre `c` and heading `theta`. Once the fit has
 // settled on every point (or after three iterations), points more than max(min_drop, 3 rms) from
-// the shape are dropped (fringe, corners), and it goes on until it settles again. `use` is
-// scratch (which points are still in), kept by the caller from call to call.
+// the shape are dropped (fringe, corners), and it goes on until it settles again. `scratch` holds
+// each point's state (in the fit, on which part of the shape, or dropped), kept by the caller from
+// call to call. A rectangle's sums come from moments of its points kept per part of the shape, so
+// an iteration costs a pass that finds the points that changed part, not a sum over all of them.
 ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Eigen::Vector2d c,
-                   double theta, double min_drop, std::vector<char>& use);
+                   double theta, double min_drop, std::vector<char>& scratch);
 
 }  // namespace lampnav::vision::detail
