@@ -51,17 +51,24 @@ ShapeFit fit_rectangle(const EdgePoints& pts, double a, double b, Vector2d c, do
   for (int it = 0; it < 20; ++it) {
     const double cs = std::cos(theta), sn = std::sin(theta);
     const double drop = dropping ? std::max(min_drop, 3.0 * rms) : HUGE_VAL;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      if (!first && cls[i] == dropped) continue;  // once dropped, a point stays dropped
-      const Vector2d p = pts[i] - origin;
-      const double dx = pts[i].x() - c.x(), dy = pts[i].y() - c.y();
+    // Through local pointers: the classes are bytes, and a byte store could alias anything, so
+    // the compiler would read the vectors' bounds again after each one.
+    const Vector2d* const pt = pts.data();
+    char* const cl = cls.data();
+    const std::size_t count = pts.size();
+    const double cx = c.x(), cy = c.y();
+    for (std::size_t i = 0; i < count; ++i) {
+      const Class was = static_cast<Class>(cl[i]);
+      if (!first && was == dropped) continue;  // once dropped, a point stays dropped
+      const double dx = pt[i].x() - cx, dy = pt[i].y() - cy;
       double r;
       Class k = classify(cs * dx + sn * dy, -sn * dx + cs * dy, a, b, r);
       if (std::fabs(r) > drop) k = dropped;
-      if (!first && k == cls[i]) continue;
-      if (!first) m[cls[i]].add(p, -1.0);
+      if (!first && k == was) continue;
+      const Vector2d p = pt[i] - origin;
+      if (!first) m[was].add(p, -1.0);
       if (k != dropped) m[k].add(p, 1.0);
-      cls[i] = k;
+      cl[i] = k;
     }
     first = false;
     // Per class: T = sum (p - d) and P = sum (p - d)(p - d)^T, d = c - origin; then the sums of
