@@ -5,8 +5,8 @@
 
 #include <gtest/gtest.h>
 
-#include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -58,14 +58,16 @@ ShapeFit by_definition(const EdgePoints& pts, double a, double b, Vector2d c, do
     fit.points = n;
     fit.rms = rms;
     if (ends < 4 || sides < 8) return fit;
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(JtJ, Eigen::EigenvaluesOnly);
-    if (eig.eigenvalues()(0) < 1e-9 * std::max(1.0, eig.eigenvalues()(2))) return fit;
-    const Eigen::Vector3d step = -JtJ.ldlt().solve(Jtr);
-    c += step.head<2>();
-    theta += step(2);
-    const bool settled = step.head<2>().norm() < 1e-6 && std::fabs(step(2)) < 1e-5;
-    if (settled && dropping) break;
-    dropping = dropping || settled || it >= 2;
+    // J^T J is symmetric and semi-definite: its singular values are its eigenvalues.
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(JtJ, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    const Eigen::Vector3d sv = svd.singularValues();  // largest first
+    if (sv(2) < 1e-9 * std::max(1.0, sv(0))) return fit;
+    const Eigen::Vector3d delta = svd.solve(-Jtr);
+    c += delta.head<2>();
+    theta += delta(2);
+    const bool small_step = delta.head<2>().norm() < 1e-6 && std::fabs(delta(2)) < 1e-5;
+    if (dropping && small_step) break;
+    if (small_step || it >= 2) dropping = true;
   }
   fit.centre = c;
   fit.orientation = theta;

@@ -36,6 +36,30 @@ Class classify(double qx, double qy, double a, double b, double& r) {
   return static_cast<Class>(end ? int(qx < 0) : 2 + int(qy < 0));
 }
 
+// One Gauss-Newton step on the centre and heading, iteration `it`. Points are dropped from the
+// iteration after the fit first settles on all of them (a step below the tolerance, or after
+// three iterations), and the fit is done when it settles again with the points it keeps.
+enum class Step { singular, again, done };
+Step gauss_newton_step(const Eigen::Matrix3d& JtJ, const Eigen::Vector3d& Jtr, int it, Vector2d& c,
+                       double& theta, bool& dropping) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(JtJ, Eigen::EigenvaluesOnly);
+  if (eig.eigenvalues()(0) < 1e-9 * std::max(1.0, eig.eigenvalues()(2))) return Step::singular;
+  const Eigen::Vector3d step = -JtJ.ldlt().solve(Jtr);
+  c += step.head<2>();
+  theta += step(2);
+  const bool settled = step.head<2>().norm() < 1e-6 && std::fabs(step(2)) < 1e-5;
+  if (settled && dropping) return Step::done;
+  dropping = dropping || settled || it >= 2;
+  return Step::again;
+}
+
+ShapeFit fitted(ShapeFit fit, const Vector2d& c, double theta) {
+  fit.centre = c;
+  fit.orientation = theta;
+  fit.ok = true;
+  return fit;
+}
+
 ShapeFit fit_rectangle(const EdgePoints& pts, double a, double b, Vector2d c, double theta,
                        double min_drop, std::vector<char>& cls) {
   ShapeFit fit;
@@ -120,19 +144,11 @@ ShapeFit fit_rectangle(const EdgePoints& pts, double a, double b, Vector2d c, do
     JtJ(2, 2) = qq_end + qq_side;
     const Eigen::Vector3d Jtr(-cs * sr_end + sn * sr_side, -sn * sr_end - cs * sr_side,
                               srq_end - srq_side);
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(JtJ, Eigen::EigenvaluesOnly);
-    if (eig.eigenvalues()(0) < 1e-9 * std::max(1.0, eig.eigenvalues()(2))) return fit;
-    const Eigen::Vector3d step = -JtJ.ldlt().solve(Jtr);
-    c += step.head<2>();
-    theta += step(2);
-    const bool settled = step.head<2>().norm() < 1e-6 && std::fabs(step(2)) < 1e-5;
-    if (settled && dropping) break;
-    dropping = dropping || settled || it >= 2;
+    const Step step = gauss_newton_step(JtJ, Jtr, it, c, theta, dropping);
+    if (step == Step::singular) return fit;
+    if (step == Step::done) break;
   }
-  fit.centre = c;
-  fit.orientation = theta;
-  fit.ok = true;
-  return fit;
+  return fitted(fit, c, theta);
 }
 
 }  // namespace
@@ -172,19 +188,11 @@ ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Ve
     fit.rms = rms;
     Eigen::Matrix3d JtJ;
     JtJ << h00, h01, 0, h01, h11, 0, 0, 0, 1.0;
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(JtJ, Eigen::EigenvaluesOnly);
-    if (eig.eigenvalues()(0) < 1e-9 * std::max(1.0, eig.eigenvalues()(2))) return fit;
-    const Eigen::Vector3d step = -JtJ.ldlt().solve(Eigen::Vector3d(g0, g1, 0));
-    c += step.head<2>();
-    theta += step(2);
-    const bool settled = step.head<2>().norm() < 1e-6 && std::fabs(step(2)) < 1e-5;
-    if (settled && dropping) break;
-    dropping = dropping || settled || it >= 2;
+    const Step step = gauss_newton_step(JtJ, Eigen::Vector3d(g0, g1, 0), it, c, theta, dropping);
+    if (step == Step::singular) return fit;
+    if (step == Step::done) break;
   }
-  fit.centre = c;
-  fit.orientation = theta;
-  fit.ok = true;
-  return fit;
+  return fitted(fit, c, theta);
 }
 
 }  // namespace lampnav::vision::detail
