@@ -1,6 +1,7 @@
 #include "run_mask.hpp"
 
 #include <algorithm>
+#include <array>
 
 namespace lampnav::vision::detail {
 
@@ -73,10 +74,14 @@ void add_joined(const Span* first, const Span* last, RunMask& out) {
 
 constexpr int kMaxDirect = 15;  // rows joined without the general merge: radius 7 at most
 
-// Rows y0..y1 (inclusive) hold one span each.
-bool single_spans(const RunMask& in, int y0, int y1) {
-  for (int j = y0; j <= y1; ++j)
-    if (in.row_end(j) - in.row_begin(j) != 1) return false;
+// Rows y0..y1 (inclusive) hold at most one span each; `empty` is set when one holds none.
+bool single_spans(const RunMask& in, int y0, int y1, bool& empty) {
+  empty = false;
+  for (int j = y0; j <= y1; ++j) {
+    const auto n = in.row_end(j) - in.row_begin(j);
+    if (n > 1) return false;
+    empty |= n == 0;
+  }
   return true;
 }
 
@@ -89,9 +94,12 @@ void along_columns(const RunMask& in, int r, bool erode, RunMask& out, std::vect
   for (int y = 0; y < h; ++y) {
     out.begin_row();
     if (y < r || y >= h - r) continue;
-    // The common case, a convex blob: one span in each of the 2r + 1 rows, joined directly.
-    if (2 * r + 1 <= kMaxDirect && single_spans(in, y - r, y + r)) {
+    // The common case, a convex blob (and the empty rows of its margin): at most one span in each
+    // of the 2r + 1 rows, joined directly.
+    bool empty = false;
+    if (2 * r + 1 <= kMaxDirect && single_spans(in, y - r, y + r, empty)) {
       if (erode) {
+        if (empty) continue;
         int a = in.row_begin(y - r)->a, b = in.row_begin(y - r)->b;
         for (int j = y - r + 1; j <= y + r; ++j)
           a = std::max(a, in.row_begin(j)->a), b = std::min(b, in.row_begin(j)->b);
@@ -99,15 +107,16 @@ void along_columns(const RunMask& in, int r, bool erode, RunMask& out, std::vect
         continue;
       }
       // Sorted by their first column (insertion: a handful), then joined where they touch.
-      Span sorted[kMaxDirect];
+      std::array<Span, kMaxDirect> sorted;
       int n = 0;
       for (int j = y - r; j <= y + r; ++j) {
+        if (in.row_begin(j) == in.row_end(j)) continue;
         const Span s = *in.row_begin(j);
         int k = n++;
         for (; k > 0 && sorted[k - 1].a > s.a; --k) sorted[k] = sorted[k - 1];
         sorted[k] = s;
       }
-      add_joined(sorted, sorted + n, out);
+      add_joined(sorted.data(), sorted.data() + n, out);
       continue;
     }
     x.assign(in.row_begin(y - r), in.row_end(y - r));
