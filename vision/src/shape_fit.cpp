@@ -67,12 +67,10 @@ ShapeFit fit_rectangle(const EdgePoints& pts, double a, double b, Vector2d c, do
   const Vector2d origin = c;
   std::array<PointMoments, kClasses> m{};
   cls.assign(pts.size(), dropped);
-  bool first = true;
   double rms = 0;
-  // Points are dropped once the fit has settled on all of them (a step below the tolerance, or
-  // after three iterations), and the fit ends when it settles again with the points it keeps.
-  bool dropping = false;
+  bool dropping = false;  // gauss_newton_step's
   for (int it = 0; it < 20; ++it) {
+    const bool first = it == 0;  // every point is classed; after, only changes are moved
     const double cs = std::cos(theta), sn = std::sin(theta);
     const double drop = dropping ? std::max(min_drop, 3.0 * rms) : HUGE_VAL;
     // Through local pointers: the classes are bytes, and a byte store could alias anything, so
@@ -94,7 +92,6 @@ ShapeFit fit_rectangle(const EdgePoints& pts, double a, double b, Vector2d c, do
       if (k != dropped) m[k].add(p, 1.0);
       cl[i] = k;
     }
-    first = false;
     // Per class: T = sum (p - d) and P = sum (p - d)(p - d)^T, d = c - origin; then the sums of
     // q_x, q_y and their products follow from e = (cos, sin) and f = (-sin, cos).
     const Vector2d d = c - origin;
@@ -154,8 +151,9 @@ ShapeFit fit_rectangle(const EdgePoints& pts, double a, double b, Vector2d c, do
 }  // namespace
 
 ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Vector2d c,
-                   double theta, double min_drop, std::vector<char>& use) {
-  if (rectangle) return fit_rectangle(pts, a, b, c, theta, min_drop, use);
+                   double theta, double min_drop, std::vector<char>& scratch) {
+  if (rectangle) return fit_rectangle(pts, a, b, c, theta, min_drop, scratch);
+  std::vector<char>& use = scratch;  // 1 while a point is in the fit
   // A disc: its distance to a point needs the point's own square root, so it is summed point by
   // point. Its heading is pinned (unit information, zero gradient) and the same 3x3 solved.
   ShapeFit fit;
