@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <tuple>
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/chi_square.hpp"
@@ -137,37 +138,60 @@ LabelResult LampLabeller::label(const vision::LampDetection& d, const Pose2& pre
   return r;
 }
 
+namespace {
+
+// A kind of lamp: shape, then length and width in mm (a disc's width is its diameter).
+using LampKind = std::tuple<graph::LampShape, long, long>;
+
+LampKind kind_of(const graph::Lamp& l) {
+  return {l.shape, std::lround(l.length * 1000), std::lround(l.width * 1000)};
+}
+
+}  // namespace
+
 vision::LampShapePrior shape_prior_for(const graph::TopologicalMap& map,
                                        const CameraDescription& camera) {
   const double cam_z = camera.mount.xyz.z();
-  std::map<std::pair<long, long>, int> sizes;  // (length, width) in mm -> count
-  double lo = 1e9, hi = -1e9;
-  std::vector<double> heights;
-  int discs = 0, rects = 0;
-  for (const auto& n : map.nodes()) {
-    for (const auto& l : n.lamps) {
-      const double dz = l.xyz.z() - cam_z;
-      if (dz <= 0.1) continue;
-      ++sizes[{std::lround(l.length * 1000), std::lround(l.width * 1000)}];
-      lo = std::min(lo, dz);
-      hi = std::max(hi, dz);
-      heights.push_back(dz);
-      (l.shape == graph::LampShape::disc ? discs : rects) += 1;
-    }
+  auto above = [&](const graph::Lamp& l) { return l.xyz.z() - cam_z > 0.1; };
+  // The kind the robot drives under: counted over the places routes go through, not the rooms
+  // (an office's rooms often hold more lamps, of another kind, than its corridors). A map whose
+  // every lamp is in a room counts them all.
+  std::map<LampKind, int> count;
+  for (const bool rooms_too : {false, true}) {
+    for (const auto& n : map.nodes())
+      if (rooms_too || n.place != graph::Place::room)
+        for (const auto& l : n.lamps)
+          if (above(l)) ++count[kind_of(l)];
+    if (!count.empty()) break;
   }
-  if (heights.empty())
+  if (count.empty())
     throw InputError({map.name(), "lamps", ""}, "no lamp is above the ceiling camera");
-  const auto common = std::max_element(
-      sizes.begin(), sizes.end(), [](const auto& a, const auto& b) { return a.second < b.second; });
-  std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
+  // The most common kind (the first in order on a tie: rectangles before discs).
+  const LampKind kind =
+      std::max_element(count.begin(), count.end(), [](const auto& a, const auto& b) {
+        return a.second < b.second;
+      })->first;
+  // Its lamps' heights above the camera, wherever they are.
+  std::vector<double> heights;
+  for (const auto& n : map.nodes())
+    for (const auto& l : n.lamps)
+      if (above(l) && kind_of(l) == kind) heights.push_back(l.xyz.z() - cam_z);
+  const auto [lo, hi] = std::minmax_element(heights.begin(), heights.end());
   vision::LampShapePrior p;
-  p.rectangle = rects >= discs;
-  p.length = common->first.first / 1000.0;
-  p.width = p.rectangle ? common->first.second / 1000.0 : p.length;
-  p.min_distance = lo;
-  p.max_distance = hi;
+  p.rectangle = std::get<0>(kind) == graph::LampShape::rectangle;
+  p.length = std::get<1>(kind) / 1000.0;
+  p.width = p.rectangle ? std::get<2>(kind) / 1000.0 : p.length;
+  p.min_distance = *lo;
+  p.max_distance = *hi;
+  std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
   p.nominal_distance = heights[heights.size() / 2];
   return p;
+}
+
+bool detects(const vision::LampShapePrior& prior, const graph::Lamp& lamp) {
+  return (lamp.shape == graph::LampShape::rectangle) == prior.rectangle &&
+         std::lround(lamp.length * 1000) == std::lround(prior.length * 1000) &&
+         std::lround(lamp.width * 1000) == std::lround(prior.width * 1000);
 }
 
 struct CeilingPipeline::Impl {
@@ -267,13 +291,15 @@ CeilingObservation CeilingPipeline::Impl::label(Stamp stamp, const vision::Track
 }
 
 int unseen_lamps(const graph::TopologicalMap& map, const vision::PinholeCamera& cam,
-                 const CeilingGeometry& geometry, const std::vector<vision::LampDetection>& lamps,
-                 const Pose2& pose, const Eigen::Matrix3d& P) {
+                 const CeilingGeometry& geometry, const vision::LampShapePrior& detected,
+                 const std::vector<vision::LampDetection>& lamps, const Pose2& pose,
+                 const Eigen::Matrix3d& P) {
   const double sigma = std::sqrt(std::max(P(0, 0), P(1, 1)));
   if (sigma > 0.3) return 0;
   const double fx = cam.parameters().fx;
   int missing = 0;
   for (const graph::Lamp* l : map.lamps_within(pose.translation(), 4.0)) {
+    if (!detects(detected, *l)) continue;  // a lamp of another kind is not looked for
     const auto n = geometry.predict(pose, l->xyz);
     if (!n) continue;
     const double h = std::max(0.5, l->xyz.z() - geometry.mount_origin().z());

@@ -79,6 +79,7 @@ struct HypothesisSet::Impl {
   std::optional<LampLabeller> labeller;
   std::optional<CeilingGeometry> geometry;
   std::optional<vision::PinholeCamera> camera;
+  std::optional<vision::LampShapePrior> kind;  // the lamps the ceiling camera looks for
   PoseMeasurementOptions measurement;
   bool has_regions = false;
 
@@ -149,6 +150,7 @@ struct HypothesisSet::Impl {
       labeller.emplace(m, *ceiling_camera, co.labeller);
       geometry.emplace(*ceiling_camera);
       camera.emplace(*ceiling_camera);
+      kind = shape_prior_for(m, *ceiling_camera);
     }
     for (const auto& n : m.nodes())
       if (n.region.size() >= 3) has_regions = true;
@@ -259,8 +261,8 @@ struct HypothesisSet::Impl {
     }
     double cost = o.ceiling_spurious_cost * unexplained;
     if (!lamps.empty())  // a dark frame says nothing of missing lamps
-      cost +=
-          o.ceiling_miss_cost * unseen_lamps(*map, *camera, *geometry, lamps, h.pose, h.covariance);
+      cost += o.ceiling_miss_cost *
+              unseen_lamps(*map, *camera, *geometry, *kind, lamps, h.pose, h.covariance);
     if (!labelled.empty()) {
       PoseRefusal refusal = PoseRefusal::none;
       const std::optional<PoseMeasurement> m =

@@ -45,6 +45,7 @@ struct Localizer::Impl {
   std::optional<CeilingPipeline> pipeline;
   std::optional<vision::PinholeCamera> ceiling_model;
   std::optional<CeilingGeometry> ceiling_geometry;
+  std::optional<vision::LampShapePrior> ceiling_kind;  // the lamps the ceiling camera looks for
   std::optional<vision::OmniLampDetector> omni_detector;
   std::optional<OmniCheck> omni_check;
   std::optional<GlobalLocalizer> global;
@@ -76,6 +77,7 @@ struct Localizer::Impl {
       pipeline.emplace(m, *ceiling_camera, o.ceiling);
       ceiling_model.emplace(*ceiling_camera);
       ceiling_geometry.emplace(*ceiling_camera);
+      ceiling_kind = shape_prior_for(m, *ceiling_camera);
     }
     if (const CameraDescription* c = robot.find_camera("omni_camera")) {
       omni_detector.emplace(*c, o.omni_detector);
@@ -246,8 +248,8 @@ struct Localizer::Impl {
     if (ceiling_model) {
       std::vector<vision::LampDetection> seen;
       for (const auto& l : ob.lamps) seen.push_back(l.detection);
-      e.expected_missing =
-          unseen_lamps(*map, *ceiling_model, *ceiling_geometry, seen, prior.pose(), prior.P);
+      e.expected_missing = unseen_lamps(*map, *ceiling_model, *ceiling_geometry, *ceiling_kind,
+                                        seen, prior.pose(), prior.P);
     }
     e.inconsistent = ob.no_measurement == PoseRefusal::labels_disagree;
     if (unsure()) {

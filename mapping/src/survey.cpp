@@ -207,7 +207,21 @@ SurveyResult survey(const graph::TopologicalMap& map, const MappingResult& drive
   }
   out.drive_to_map = T;
 
-  // 2. Map lamps the ceiling camera had clearly in view, and how often.
+  // 2. Map lamps the ceiling camera had clearly in view, and how often. Only lamps of a kind the
+  // drive saw: its detector looks for one kind, and a lamp of another (a room's round lamp seen
+  // from a corridor of long ones) is not judged, never taken for failed and out of the map.
+  std::vector<const MappedLamp*> kinds;
+  for (const MappedLamp& s : seen) {
+    bool known = false;
+    for (const MappedLamp* k : kinds)
+      known = known || (k->shape == s.shape && std::abs(k->length - s.length) < 0.1 * k->length);
+    if (!known) kinds.push_back(&s);
+  }
+  auto looked_for = [&](const graph::Lamp& l) {
+    for (const MappedLamp* k : kinds)
+      if (same_kind(k->shape, k->length, l)) return true;
+    return false;
+  };
   const fusion::CeilingGeometry geometry(*cam);
   const vision::PinholeCamera pinhole(*cam);
   const double mu = o.view_margin * cam->width, mv = o.view_margin * cam->height;
@@ -215,6 +229,7 @@ SurveyResult survey(const graph::TopologicalMap& map, const MappingResult& drive
   for (const auto& k : drive.keyframes) {
     const Pose2 q = T * k.pose;
     for (const graph::Lamp* l : map.lamps_within(q.translation(), 4.0)) {
+      if (!looked_for(*l)) continue;
       const auto n = geometry.predict(q, l->xyz);
       if (!n) continue;
       const auto px = pinhole.project(Vector3d(n->x(), n->y(), 1.0));

@@ -8,11 +8,14 @@
 #include <filesystem>
 #include <set>
 
+#include "lampnav/fusion/ceiling_geometry.hpp"
 #include "lampnav/fusion/ceiling_pipeline.hpp"
 #include "lampnav/fusion/ekf.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
+#include "lampnav/sim/building.hpp"
 #include "lampnav/sim/scenario.hpp"
+#include "lampnav/vision/camera_models.hpp"
 #include "lampnav_test.hpp"
 
 namespace lampnav::fusion {
@@ -28,15 +31,25 @@ struct Score {
   double mean_yaw_deg() const { return sum_yaw / measurements * 180 / M_PI; }
 };
 
+RobotDescription pioneer() {
+  return read_robot_description(test::source_path("maps/robots/pioneer.json"));
+}
+
+// Records scenario `s` on `map` (ceiling camera only) and scores the pipeline over it.
+Score drive(const graph::TopologicalMap& map, sim::Scenario s, const RobotDescription& robot);
+
 Score corridor(double bump_rad, const std::set<std::string>& failed, std::uint64_t seed) {
   const std::string geojson = test::slurp(test::source_path("maps/office_floor.geojson"));
   const graph::TopologicalMap map = graph::parse_map(geojson, "office_floor.geojson").map;
-  const RobotDescription robot =
-      read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  const RobotDescription robot = pioneer();
   sim::Scenario s = sim::make_named_scenario("corridor", map, geojson, robot, seed);
-  s.omni_rate = 0;
   s.bump_sigma_rad = bump_rad;
   s.failed_lamps = failed;
+  return drive(map, std::move(s), robot);
+}
+
+Score drive(const graph::TopologicalMap& map, sim::Scenario s, const RobotDescription& robot) {
+  s.omni_rate = 0;
   const std::string path = (std::filesystem::temp_directory_path() /
                             ("lampnav_pipeline_" + std::to_string(::getpid()) + ".mcap"))
                                .string();
@@ -139,6 +152,101 @@ TEST(CeilingPipeline, CorridorWithAFailedLamp) {
   EXPECT_EQ(s.wrong_labels, 0);
   EXPECT_GT(s.measurements, s.frames * 6 / 10);
   EXPECT_LE(s.mean_pos(), 0.04);
+}
+
+// Offices often hold more lamps in their rooms, of another kind, than in their corridors. The
+// detector looks for the kind the robot drives under: here the corridors' rectangles, not the
+// rooms' round lamps, which outnumber them (before, every lamp of the drive went unseen).
+TEST(CeilingPipeline, CorridorsOfABuildingWhoseRoomsHoldMoreLamps) {
+  sim::BuildingOptions b;
+  b.nodes = 30;
+  b.block_m = 14;
+  b.lamp_spacing_m = 2.5;
+  b.seed = 7;
+  const std::string geojson = sim::generate_building(b).geojson;
+  const graph::TopologicalMap map = graph::parse_map(geojson, "building.geojson").map;
+  int in_rooms = 0, elsewhere = 0;
+  for (const auto& n : map.nodes())
+    (n.place == graph::Place::room ? in_rooms : elsewhere) += int(n.lamps.size());
+  ASSERT_GT(in_rooms, elsewhere);  // the case this test is for
+
+  const RobotDescription robot = pioneer();
+  const vision::LampShapePrior kind = shape_prior_for(map, *robot.find_camera("ceiling_camera"));
+  EXPECT_TRUE(kind.rectangle);
+  EXPECT_DOUBLE_EQ(kind.length, 1.2);
+  EXPECT_DOUBLE_EQ(kind.width, 0.3);
+
+  const Score s =
+      drive(map, sim::make_route_scenario(map, geojson, robot, "J0_0", "J2_2", 4), robot);
+  EXPECT_EQ(s.wrong_labels, 0);
+  EXPECT_GT(s.labels, s.lamps_seen * 9 / 10);
+  EXPECT_GT(s.measurements, s.frames * 8 / 10);
+  EXPECT_LE(s.mean_pos(), 0.04);
+}
+
+graph::Lamp lamp_at(const std::string& id, double x, graph::LampShape shape, double length,
+                    double width) {
+  graph::Lamp l;
+  l.id = LampId(id);
+  l.xyz = Eigen::Vector3d(x, 0, 2.7);
+  l.shape = shape;
+  l.length = length;
+  l.width = width;
+  return l;
+}
+
+// One kind gives both the shape and the size: five rectangles of two sizes and four discs make
+// discs the commonest kind, not a rectangle the size of a disc.
+TEST(CeilingPipeline, ShapeAndSizeComeFromOneKindOfLamp) {
+  graph::TopologicalMap map("kinds");
+  graph::Node n;
+  n.id = NodeId(1);
+  n.name = "H1";
+  n.place = graph::Place::hall;
+  const auto rect = graph::LampShape::rectangle, disc = graph::LampShape::disc;
+  for (int i = 0; i < 3; ++i)
+    n.lamps.push_back(lamp_at("R" + std::to_string(i), i, rect, 1.2, 0.3));
+  for (int i = 0; i < 2; ++i)
+    n.lamps.push_back(lamp_at("S" + std::to_string(i), 10 + i, rect, 0.6, 0.6));
+  for (int i = 0; i < 4; ++i)
+    n.lamps.push_back(lamp_at("D" + std::to_string(i), 20 + i, disc, 0.6, 0.6));
+  map.add_node(n);
+  const vision::LampShapePrior kind =
+      shape_prior_for(map, *pioneer().find_camera("ceiling_camera"));
+  EXPECT_FALSE(kind.rectangle);
+  EXPECT_DOUBLE_EQ(kind.length, 0.6);
+  EXPECT_TRUE(detects(kind, map.node(NodeId(1)).lamps.back()));
+  EXPECT_FALSE(detects(kind, map.node(NodeId(1)).lamps.front()));
+  EXPECT_FALSE(detects(kind, map.node(NodeId(1)).lamps[3]));  // a square rectangle is no disc
+}
+
+// A lamp the detector does not look for is not missing when it is not seen: under a room's round
+// lamps, with the corridors' rectangles looked for, an empty frame misses nothing; it misses the
+// round lamps when those are the ones looked for.
+TEST(CeilingPipeline, LampsOfAnotherKindAreNotMissing) {
+  sim::BuildingOptions b;
+  b.nodes = 30;
+  b.block_m = 14;
+  b.seed = 7;
+  const graph::TopologicalMap map =
+      graph::parse_map(sim::generate_building(b).geojson, "building.geojson").map;
+  const CameraDescription& cam = *pioneer().find_camera("ceiling_camera");
+  const vision::PinholeCamera model(cam);
+  const CeilingGeometry geometry(cam);
+  const vision::LampShapePrior corridors = shape_prior_for(map, cam);
+  ASSERT_TRUE(corridors.rectangle);
+  const graph::Lamp* round = nullptr;
+  for (const auto& n : map.nodes())
+    for (const auto& l : n.lamps)
+      if (!round && n.place == graph::Place::room && l.shape == graph::LampShape::disc) round = &l;
+  ASSERT_NE(round, nullptr);
+  vision::LampShapePrior rooms = corridors;
+  rooms.rectangle = false;
+  rooms.length = rooms.width = round->length;
+  const Pose2 under(round->xyz.x(), round->xyz.y(), 0.3);
+  const Eigen::Matrix3d P = Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal();
+  EXPECT_EQ(unseen_lamps(map, model, geometry, corridors, {}, under, P), 0);
+  EXPECT_GE(unseen_lamps(map, model, geometry, rooms, {}, under, P), 1);
 }
 
 }  // namespace

@@ -73,5 +73,33 @@ TEST(Survey, FindsTheFailedMovedAndNewLampsAndNothingElse) {
   EXPECT_EQ(up.lamp_count(), map.lamp_count() - 3 + 1);
 }
 
+// The drive's detector looks for one kind of lamp (the office's long ones): a round lamp the map
+// has in a corridor is not judged. Before, it was reported failed, and --update took it out of
+// the map.
+TEST(Survey, LampsOfAKindTheDriveDoesNotSeeAreNotJudged) {
+  const graph::TopologicalMap world =
+      graph::read_map(test::source_path("maps/office_floor.geojson")).map;
+  const graph::TopologicalMap map = test::edited(world, [](graph::Node& c) {
+    if (c.name != "C6") return;
+    graph::Lamp round = c.lamps[1];
+    round.id = LampId("C6-ROUND");
+    round.shape = graph::LampShape::disc;
+    round.length = round.width = 0.6;
+    round.xyz.x() = 0.5 * (c.lamps[1].xyz.x() + c.lamps[2].xyz.x());
+    c.lamps.insert(c.lamps.begin() + 2, round);
+  });
+  const RobotDescription robot =
+      read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  // Sensors of the world without the round lamp: a detector that does not look for it.
+  const sim::LampSensors sensors(world, robot);
+  const test::DriveRecord drive =
+      test::drive_through(test::office_every_corridor(), 0.0, sensors, robot.semi_axis);
+  const SurveyResult s = survey(map, test::map_drive(drive, robot), robot);
+  for (const auto& f : s.findings) ADD_FAILURE() << to_string(f.status) << " " << f.lamp;
+  EXPECT_GT(s.judged, 40);
+  EXPECT_EQ(s.ok, s.judged);
+  EXPECT_NE(s.updated.find_lamp(LampId("C6-ROUND")), nullptr);
+}
+
 }  // namespace
 }  // namespace lampnav::mapping

@@ -66,18 +66,22 @@ class LampLabeller {
   double gate_;
 };
 
-// The detector's shape prior from a map's lamps and the camera's height: the most common lamp
-// size, and the range of lamp heights above the camera. Throws InputError when the map has no
-// lamp above the camera.
+// The detector's shape prior from a map's lamps and the camera's height: the most common kind of
+// lamp (shape and size) over the places routes go through (rooms left out, unless every lamp is
+// in one), and the range of its lamps' heights above the camera. Throws InputError when the map
+// has no lamp above the camera.
 vision::LampShapePrior shape_prior_for(const graph::TopologicalMap& map,
                                        const CameraDescription& camera);
+// Whether a detector with this prior looks for the lamp: the same shape and size (to the mm).
+bool detects(const vision::LampShapePrior& prior, const graph::Lamp& lamp);
 
-// Map lamps a pose (known within `covariance`) puts so well inside the image that, even 3 sigma
-// off, they would be in full view, and near which nothing was detected. 0 when the pose is too
-// uncertain (over 0.3 m) to say.
+// Map lamps of the kind `detected` looks for that a pose (known within `covariance`) puts so
+// well inside the image that, even 3 sigma off, they would be in full view, and near which
+// nothing was detected. 0 when the pose is too uncertain (over 0.3 m) to say.
 int unseen_lamps(const graph::TopologicalMap& map, const vision::PinholeCamera& camera,
-                 const CeilingGeometry& geometry, const std::vector<vision::LampDetection>& lamps,
-                 const Pose2& pose, const Eigen::Matrix3d& covariance);
+                 const CeilingGeometry& geometry, const vision::LampShapePrior& detected,
+                 const std::vector<vision::LampDetection>& lamps, const Pose2& pose,
+                 const Eigen::Matrix3d& covariance);
 
 struct CeilingPipelineOptions {
   vision::LampDetectorOptions detector;
