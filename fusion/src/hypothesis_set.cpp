@@ -56,6 +56,7 @@ void HypothesisSetOptions::validate() const {
   check(drop_ratio > 0 && drop_ratio < 1e-3, "drop_ratio", "must be in (0, 0.001)");
   check(birth_ratio >= drop_ratio && birth_ratio < 1, "birth_ratio", "must be in [drop_ratio, 1)");
   check(symmetry_check_max >= 2, "symmetry_check_max", "must be at least 2");
+  check(station_m >= 0, "station_m", "must not be negative");
   check(enumerate_every_m >= 0 && enumerate_every_deg >= 0, "enumerate_every_m",
         "must not be negative");
   check(frame_cost_cap > 0, "frame_cost_cap", "must be positive");
@@ -373,6 +374,7 @@ struct HypothesisSet::Impl {
     return h;
   }
 
+  bool same_station = false;  // carry_places: this image was taken where the last one was
   // The places carried to `stamp` (those gone through a wall left behind), and the gate an
   // image's poses must fall within to be one of them.
   EnumerationPrior carry_places(Stamp stamp, const OdometryTrack& odo) {
@@ -395,9 +397,12 @@ struct HypothesisSet::Impl {
     places = std::move(kept);
     prior.gate_m = o.place_gate_m + 3 * o.sigma_per_m * travel;
     prior.gate_rad = (o.place_gate_deg + 3 * o.sigma_yaw_deg_per_m * travel) * kDeg;
-    prior.view_cost_cap = o.frame_cost_cap;
+    // An image from where the last one was taken (a turn on the spot: the omni camera sees the
+    // same ceiling turned) says again what that one said: it narrows the places, it adds no cost.
+    same_station = !places.empty() && moved.translation().norm() < o.station_m;
+    prior.view_cost_cap = same_station ? 0.0 : o.frame_cost_cap;
     prior.cost_max = o.place_cost_max;
-    prior.view_allowance = o.place_allowance;
+    prior.view_allowance = same_station ? 0.0 : o.place_allowance;
     return prior;
   }
 
@@ -420,7 +425,7 @@ struct HypothesisSet::Impl {
       for (Place p : places) {
         if (allowed.near(p.pose, prior->gate_m, prior->gate_rad)) continue;
         if (says) {
-          p.cost += o.frame_cost_cap - o.place_allowance;
+          if (!same_station) p.cost += o.frame_cost_cap - o.place_allowance;
           if (p.cost > o.place_cost_max) continue;
           missed.push_back(p);
         }

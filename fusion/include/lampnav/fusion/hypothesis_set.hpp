@@ -53,6 +53,12 @@ struct HypothesisSetOptions {
   // off on rendered views), and well under the lamp spacing that separates look-alike places.
   double place_gate_m = 1.0, place_gate_deg = 12.0;
   double place_cost_max = 30.0;
+  // Images taken within this distance (m, of the robot) of the last enumeration (a turn on the
+  // spot, the omni camera seeing the same ceiling turned) add no cost to the places: their
+  // evidence is the last image's again. Counted anew, four images of one spot in a turn dropped
+  // the truth for its twin, whose look the spot favoured by 9 to 15 an image
+  // (docs/hypotheses.md).
+  double station_m = 0.25;
   // An image's cost a place is let off (EnumerationPrior::view_allowance). The truth's own
   // cost on rendered views has a median of 2 and is often 4.6 (a lamp missed, when a miss
   // cost that) or 6 (a blob odd), so these add up over a long drive; but letting them off
