@@ -250,12 +250,10 @@ Image8 OmniRenderer::render(const Pose2& robot, const CameraTilt& tilt,
       }
     }
   };
-  // Pixels per radian off-axis at theta (the derivative of r(theta)).
-  const auto& f = cam_.fisheye;
-  auto px_per_rad = [&](double theta) {
-    const double sec = 1.0 / std::cos(theta / f.b);
-    return f.a / f.b * sec * sec + f.c / f.d * std::cos(theta / f.d);
-  };
+  // Pixels per radian off-axis at theta (the derivative of r(theta)), of the camera's own model:
+  // Pajdla-Bakstein's a, b, c, d are zero on a Kannala-Brandt camera, whose lamps were drawn as
+  // dots of min_radius_px, too small for the detector to take for lamps.
+  auto px_per_rad = [&](double theta) { return model.radius_derivative(theta); };
   for (const graph::Lamp* lamp : lamps) {
     const Vector3d pc = cp.to_camera(lamp->xyz);
     const auto px = model.project(pc);

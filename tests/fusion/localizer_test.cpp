@@ -307,6 +307,35 @@ TEST(Localizer, KidnapOntoASpotWhoseTwinTheViewFavoursTurningThere) {
   EXPECT_TRUE(r.recovered_at_end);
 }
 
+// A Kannala-Brandt omni camera (OpenCV's fisheye model, as `robot import` writes it), 800 x 800:
+// the robot finds where it starts, then the kidnap, from its images. Before the simulator drew
+// its lamps by this model's own radius, they were dots no detector takes for lamps, and such a
+// robot never localized.
+TEST(Localizer, KannalaBrandtOmniCameraFindsTheStartAndTheKidnap) {
+  World w("maps/office_floor.geojson");
+  for (CameraDescription& c : w.robot.cameras) {
+    if (c.name != "omni_camera") continue;
+    c.model = CameraModelKind::kannala_brandt;
+    c.width = c.height = 800;
+    c.fisheye = FisheyeParameters{};
+    c.fisheye.u0 = c.fisheye.v0 = 400;
+    c.fisheye.f = 230;
+    c.fisheye.k = {0.02, -0.01, 0.002, -0.0005};
+    c.fisheye.fov_deg = 185;
+  }
+  sim::Scenario s = sim::make_route_scenario(w.map, w.geojson, w.robot, "E1", "K2", 4);
+  s.kidnaps.push_back({30.0, std::nullopt});
+  const io::MissionLog log = record(s);
+  const Outcome r = replay(s, log, w.map, false);
+  std::cout << r.summary() << "\n";
+  ASSERT_EQ(r.kidnaps.size(), 1u);
+  EXPECT_TRUE(r.kidnaps[0].lost);
+  EXPECT_GE(r.relocalizations, 2);  // the start, and after the kidnap
+  EXPECT_EQ(r.bad_fixes, 0);
+  EXPECT_TRUE(r.recovered_at_end);
+  EXPECT_LE(r.rms_pos(), 0.05);
+}
+
 // Paper 1's runs, omnidirectional camera only: the kidnap-free run raises no alarm and the omni
 // frames keep the estimate; in the carried run every jump is a kidnap, found by the omni check,
 // and the same image relocalizes the robot.
