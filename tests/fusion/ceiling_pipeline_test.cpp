@@ -230,7 +230,8 @@ TEST(CeilingPipeline, LampsOfAnotherKindAreNotMissing) {
   b.seed = 7;
   const graph::TopologicalMap map =
       graph::parse_map(sim::generate_building(b).geojson, "building.geojson").map;
-  const CameraDescription& cam = *pioneer().find_camera("ceiling_camera");
+  const RobotDescription robot = pioneer();
+  const CameraDescription& cam = *robot.find_camera("ceiling_camera");
   const vision::PinholeCamera model(cam);
   const CeilingGeometry geometry(cam);
   const vision::LampShapePrior corridors = shape_prior_for(map, cam);
