@@ -147,6 +147,11 @@ LampKind kind_of(const graph::Lamp& l) {
   return {l.shape, std::lround(l.length * 1000), std::lround(l.width * 1000)};
 }
 
+LampKind kind_of(const vision::LampShapePrior& p) {
+  return {p.rectangle ? graph::LampShape::rectangle : graph::LampShape::disc,
+          std::lround(p.length * 1000), std::lround(p.width * 1000)};
+}
+
 }  // namespace
 
 vision::LampShapePrior shape_prior_for(const graph::TopologicalMap& map,
@@ -189,9 +194,7 @@ vision::LampShapePrior shape_prior_for(const graph::TopologicalMap& map,
 }
 
 bool detects(const vision::LampShapePrior& prior, const graph::Lamp& lamp) {
-  return (lamp.shape == graph::LampShape::rectangle) == prior.rectangle &&
-         std::lround(lamp.length * 1000) == std::lround(prior.length * 1000) &&
-         std::lround(lamp.width * 1000) == std::lround(prior.width * 1000);
+  return kind_of(lamp) == kind_of(prior);
 }
 
 struct CeilingPipeline::Impl {
