@@ -313,16 +313,7 @@ TEST(Localizer, KidnapOntoASpotWhoseTwinTheViewFavoursTurningThere) {
 // robot never localized.
 TEST(Localizer, KannalaBrandtOmniCameraFindsTheStartAndTheKidnap) {
   World w("maps/office_floor.geojson");
-  for (CameraDescription& c : w.robot.cameras) {
-    if (c.name != "omni_camera") continue;
-    c.model = CameraModelKind::kannala_brandt;
-    c.width = c.height = 800;
-    c.fisheye = FisheyeParameters{};
-    c.fisheye.u0 = c.fisheye.v0 = 400;
-    c.fisheye.f = 230;
-    c.fisheye.k = {0.02, -0.01, 0.002, -0.0005};
-    c.fisheye.fov_deg = 185;
-  }
+  w.robot = test::with_kannala_brandt_omni(w.robot);
   sim::Scenario s = sim::make_route_scenario(w.map, w.geojson, w.robot, "E1", "K2", 4);
   s.kidnaps.push_back({30.0, std::nullopt});
   const io::MissionLog log = record(s);

@@ -261,18 +261,7 @@ TEST(LampSensors, OmniBlobsHaveTheRenderedSize) { omni_blobs_have_the_rendered_s
 // dot of min_radius_px, which the detector does not take for a lamp, and such a robot never
 // localized in the simulator.
 TEST(LampSensors, OmniBlobsHaveTheRenderedSizeOnAKannalaBrandtCamera) {
-  RobotDescription robot = pioneer();
-  for (CameraDescription& c : robot.cameras) {
-    if (c.name != "omni_camera") continue;
-    c.model = CameraModelKind::kannala_brandt;
-    c.width = c.height = 800;
-    c.fisheye = FisheyeParameters{};
-    c.fisheye.u0 = c.fisheye.v0 = 400;
-    c.fisheye.f = 230;
-    c.fisheye.k = {0.02, -0.01, 0.002, -0.0005};
-    c.fisheye.fov_deg = 185;
-  }
-  omni_blobs_have_the_rendered_size(robot);
+  omni_blobs_have_the_rendered_size(test::with_kannala_brandt_omni(pioneer()));
 }
 
 TEST(CameraPose, TiltMovesTheViewOfAHighLamp) {

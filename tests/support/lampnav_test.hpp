@@ -18,6 +18,7 @@
 #include <Eigen/Core>
 
 #include "lampnav/core/pose2.hpp"
+#include "lampnav/core/robot_description.hpp"
 
 namespace lampnav::test {
 
@@ -82,6 +83,22 @@ Eigen::Matrix<double, M, N> numerical_jacobian(F f, const Eigen::Matrix<double, 
     J.col(i) = (f(a) - f(b)) / (2 * h);
   }
   return J;
+}
+
+// The robot's omni camera replaced by an 800 x 800 Kannala-Brandt one (OpenCV's fisheye model, as
+// `robot import` writes it from an OpenCV, ROS or Kalibr calibration), 185 degrees of view.
+inline RobotDescription with_kannala_brandt_omni(RobotDescription robot) {
+  for (CameraDescription& c : robot.cameras) {
+    if (c.name != "omni_camera") continue;
+    c.model = CameraModelKind::kannala_brandt;
+    c.width = c.height = 800;
+    c.fisheye = FisheyeParameters{};
+    c.fisheye.u0 = c.fisheye.v0 = 400;
+    c.fisheye.f = 230;
+    c.fisheye.k = {0.02, -0.01, 0.002, -0.0005};
+    c.fisheye.fov_deg = 185;
+  }
+  return robot;
 }
 
 }  // namespace lampnav::test
