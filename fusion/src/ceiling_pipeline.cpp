@@ -293,14 +293,16 @@ CeilingObservation CeilingPipeline::Impl::label(Stamp stamp, const vision::Track
   return out;
 }
 
-int unseen_lamps(const graph::TopologicalMap& map, const vision::PinholeCamera& cam,
-                 const CeilingGeometry& geometry, const vision::LampShapePrior& detected,
-                 const std::vector<vision::LampDetection>& lamps, const Pose2& pose,
-                 const Eigen::Matrix3d& P) {
+std::vector<const graph::Lamp*> unseen_lamps(const graph::TopologicalMap& map,
+                                             const vision::PinholeCamera& cam,
+                                             const CeilingGeometry& geometry,
+                                             const vision::LampShapePrior& detected,
+                                             const std::vector<vision::LampDetection>& lamps,
+                                             const Pose2& pose, const Eigen::Matrix3d& P) {
+  std::vector<const graph::Lamp*> missing;
   const double sigma = std::sqrt(std::max(P(0, 0), P(1, 1)));
-  if (sigma > 0.3) return 0;
+  if (sigma > 0.3) return missing;
   const double fx = cam.parameters().fx;
-  int missing = 0;
   for (const graph::Lamp* l : map.lamps_within(pose.translation(), 4.0)) {
     if (!detects(detected, *l)) continue;  // a lamp of another kind is not looked for
     const auto n = geometry.predict(pose, l->xyz);
@@ -315,7 +317,7 @@ int unseen_lamps(const graph::TopologicalMap& map, const vision::PinholeCamera& 
     bool seen = false;
     for (const auto& d : lamps)
       if ((d.centre_px - px).norm() < margin + 0.5 * fx * l->length / h) seen = true;
-    if (!seen) ++missing;
+    if (!seen) missing.push_back(l);
   }
   return missing;
 }

@@ -388,7 +388,10 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     const Predicted& p = pred[a];
     if (p.z < cos_expect) continue;
     ++e.expected;
-    if (!p.matched && !(crowded(a) && covered(p))) ++e.missing;
+    if (!p.matched && !(crowded(a) && covered(p))) {
+      ++e.missing;
+      e.missed.push_back(p.lamp);
+    }
   }
   for (std::size_t j = 0; j < blobs.size(); ++j)
     if (!b_used[j] && !explained[j]) ++e.unexplained;
@@ -535,6 +538,7 @@ PoseHypothesis GlobalLocalizer::Impl::refine(Pose2 pose, double position_sigma, 
   h.expected = e.expected;
   h.missing = e.missing;
   h.unexplained = e.unexplained;
+  for (const int li : e.missed) h.missed.push_back(lamps[li]);
   for (const auto& [li, bj] : e.matches) {
     const double ang = std::acos(std::clamp(
         camera_point(pose, lamps[li]->xyz, tilt).normalized().dot(blobs[bj].ray), -1.0, 1.0));
@@ -655,6 +659,7 @@ GlobalLocalizer::PoseScore GlobalLocalizer::score(const Pose2& pose, double posi
   s.expected = e.expected;
   s.missing = e.missing;
   s.unexplained = e.unexplained;
+  for (const int li : e.missed) s.missed.push_back(m.lamps[li]);
   s.matched = static_cast<int>(e.matches.size());
   return s;
 }

@@ -100,6 +100,7 @@ struct Evaluation {
   double cost = std::numeric_limits<double>::infinity();
   int expected = 0, missing = 0, unexplained = 0;
   std::vector<std::pair<int, int>> matches;  // (lamp index, blob index into BlobRay list)
+  std::vector<int> missed;                   // the missing lamps (indices)
 };
 
 // The floor's tilt of the base (rad), a nuisance estimated with each pose.

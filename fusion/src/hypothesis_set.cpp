@@ -71,6 +71,7 @@ void HypothesisSetOptions::validate() const {
         "must not be negative");
   check(ceiling_miss_cost >= 0 && ceiling_spurious_cost >= 0, "ceiling_miss_cost",
         "must not be negative");
+  check(lamp_out_cost >= 0, "lamp_out_cost", "must not be negative");
 }
 
 struct HypothesisSet::Impl {
@@ -215,6 +216,29 @@ struct HypothesisSet::Impl {
     return std::sqrt(std::max(P(0, 0), P(1, 1)));
   }
 
+  // What the lamps a frame expected and did not see cost a hypothesis: `each` a lamp (a frame's
+  // miss), but no lamp's absences more than lamp_out_cost over the hypothesis's frames (it may be
+  // out). Recorded in the hypothesis.
+  double absence_cost(Hypothesis& h, const std::vector<const graph::Lamp*>& missed,
+                      double each) const {
+    double cost = 0;
+    for (const graph::Lamp* l : missed) {
+      auto it = std::find_if(h.absences.begin(), h.absences.end(),
+                             [&](const auto& a) { return a.first == l; });
+      if (it == h.absences.end()) it = h.absences.insert(h.absences.end(), {l, 0.0});
+      const double c = std::clamp(o.lamp_out_cost - it->second, 0.0, each);
+      it->second += c;
+      cost += c;
+    }
+    return cost;
+  }
+  // An omni score with its misses charged as absence_cost() does.
+  double omni_cost(Hypothesis& h, double score,
+                   const std::vector<const graph::Lamp*>& missed) const {
+    const double each = omni->options().pairs.miss_cost;
+    return score - each * static_cast<double>(missed.size()) + absence_cost(h, missed, each);
+  }
+
   // What one frame says of one hypothesis: -2 ln L, and whether it plainly contradicts it (most
   // of the lamps it predicts in clear view unseen, or most of the lamps seen unexplained).
   struct Weighed {
@@ -236,12 +260,12 @@ struct HypothesisSet::Impl {
                                       o.omni_bump_sigma_m * o.omni_bump_sigma_m,
                                       std::pow(o.omni_bump_sigma_deg * kDeg, 2));
       const int seen = static_cast<int>(r->matches.size()) + r->unexplained;
-      return {r->score + update(h, r->pose, R),
+      return {omni_cost(h, r->score, r->missed) + update(h, r->pose, R),
               contradicts(r->expected, r->missing, seen, r->unexplained)};
     }
     // Nothing to refine on: the prediction scored as it stands, with its own uncertainty.
     const GlobalLocalizer::PoseScore sc = omni->score(h.pose, ps, ys, d);
-    return {sc.cost,
+    return {omni_cost(h, sc.cost, sc.missed),
             contradicts(sc.expected, sc.missing, sc.matched + sc.unexplained, sc.unexplained)};
   }
 
@@ -262,8 +286,9 @@ struct HypothesisSet::Impl {
     }
     double cost = o.ceiling_spurious_cost * unexplained;
     if (!lamps.empty())  // a dark frame says nothing of missing lamps
-      cost += o.ceiling_miss_cost *
-              unseen_lamps(*map, *camera, *geometry, *kind, lamps, h.pose, h.covariance);
+      cost += absence_cost(
+          h, unseen_lamps(*map, *camera, *geometry, *kind, lamps, h.pose, h.covariance),
+          o.ceiling_miss_cost);
     if (!labelled.empty()) {
       PoseRefusal refusal = PoseRefusal::none;
       const std::optional<PoseMeasurement> m =
@@ -370,6 +395,9 @@ struct HypothesisSet::Impl {
     h.odometry = odo.at(stamp);
     h.log_weight = log_weight;
     h.node = p.node;
+    // The image's misses, as absence_cost() charges them (births() weighs the newborn so).
+    const double miss = std::min(omni->options().pairs.miss_cost, o.lamp_out_cost);
+    for (const graph::Lamp* l : p.missed) h.absences.emplace_back(l, miss);
     ++counts.born;
     return h;
   }
@@ -472,6 +500,14 @@ struct HypothesisSet::Impl {
     const double best_score = r.hypotheses.front().score;
     std::size_t n = 0;
     while (n < r.hypotheses.size() && r.hypotheses[n].score <= best_score + margin) ++n;
+    // Weighed with each lamp the image missed costing at most lamp_out_cost (absence_cost()).
+    const double miss = omni->options().pairs.miss_cost;
+    const auto capped = [&](const PoseHypothesis& h) {
+      return h.score - (miss - std::min(miss, o.lamp_out_cost)) * h.missing;
+    };
+    double capped_best = capped(r.hypotheses.front());
+    for (std::size_t k = 1; k < n; ++k)
+      capped_best = std::min(capped_best, capped(r.hypotheses[k]));
     // What the drive said before this image: each hypothesis is born with the cost of the
     // carried place it continues (the least within the gate), so that the places the drive has
     // told apart from the truth are born behind it, not level with it.
@@ -482,7 +518,7 @@ struct HypothesisSet::Impl {
       return std::min(drive->least(p, prior.gate_m, prior.gate_rad), o.place_cost_max);
     };
     const auto cost_of = [&](const PoseHypothesis& h) {
-      return h.score - best_score + drive_cost(h.pose);
+      return capped(h) - capped_best + drive_cost(h.pose);
     };
     // A place of the drive this image did not allow still counts while its cost stays within
     // place_cost_max (one odd image, a lamp hidden, never removes the truth): it is born too,
@@ -495,7 +531,7 @@ struct HypothesisSet::Impl {
         if (h.origin == HypothesisOrigin::kept) {
           next.push_back(h);
           next.back().log_weight =
-              std::log(o.kept_prior) - 0.5 * std::min(o.frame_cost_cap, h.last_cost - best_score);
+              std::log(o.kept_prior) - 0.5 * std::min(o.frame_cost_cap, h.last_cost - capped_best);
           kept_share = o.kept_prior;
         }
       const double each = std::log((1 - kept_share) /

@@ -248,8 +248,9 @@ struct Localizer::Impl {
     if (ceiling_model) {
       std::vector<vision::LampDetection> seen;
       for (const auto& l : ob.lamps) seen.push_back(l.detection);
-      e.expected_missing = unseen_lamps(*map, *ceiling_model, *ceiling_geometry, *ceiling_kind,
-                                        seen, prior.pose(), prior.P);
+      e.expected_missing = static_cast<int>(unseen_lamps(*map, *ceiling_model, *ceiling_geometry,
+                                                         *ceiling_kind, seen, prior.pose(), prior.P)
+                                                .size());
     }
     e.inconsistent = ob.no_measurement == PoseRefusal::labels_disagree;
     if (unsure()) {

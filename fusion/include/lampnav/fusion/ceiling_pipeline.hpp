@@ -77,11 +77,13 @@ bool detects(const vision::LampShapePrior& prior, const graph::Lamp& lamp);
 
 // Map lamps of the kind `detected` looks for that a pose (known within `covariance`) puts so
 // well inside the image that, even 3 sigma off, they would be in full view, and near which
-// nothing was detected. 0 when the pose is too uncertain (over 0.3 m) to say.
-int unseen_lamps(const graph::TopologicalMap& map, const vision::PinholeCamera& camera,
-                 const CeilingGeometry& geometry, const vision::LampShapePrior& detected,
-                 const std::vector<vision::LampDetection>& lamps, const Pose2& pose,
-                 const Eigen::Matrix3d& covariance);
+// nothing was detected. None when the pose is too uncertain (over 0.3 m) to say.
+std::vector<const graph::Lamp*> unseen_lamps(const graph::TopologicalMap& map,
+                                             const vision::PinholeCamera& camera,
+                                             const CeilingGeometry& geometry,
+                                             const vision::LampShapePrior& detected,
+                                             const std::vector<vision::LampDetection>& lamps,
+                                             const Pose2& pose, const Eigen::Matrix3d& covariance);
 
 struct CeilingPipelineOptions {
   vision::LampDetectorOptions detector;

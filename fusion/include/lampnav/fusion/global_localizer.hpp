@@ -121,7 +121,8 @@ struct PoseHypothesis {
   int missing = 0;      // of those, not seen
   int unexplained = 0;  // blobs no lamp explains
   std::vector<LampMatch> matches;
-  const graph::Node* node = nullptr;  // the node whose region holds the pose
+  std::vector<const graph::Lamp*> missed;  // the lamps in clear view not seen
+  const graph::Node* node = nullptr;       // the node whose region holds the pose
 };
 
 struct GlobalLocalization {
@@ -191,6 +192,7 @@ class GlobalLocalizer {
   struct PoseScore {
     double cost = 0;
     int expected = 0, missing = 0, unexplained = 0, matched = 0;
+    std::vector<const graph::Lamp*> missed;  // the lamps in clear view not seen
   };
   PoseScore score(const Pose2& pose, double position_sigma, double yaw_sigma,
                   const vision::OmniDetection& detection) const;

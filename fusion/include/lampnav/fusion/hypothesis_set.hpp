@@ -84,6 +84,13 @@ struct HypothesisSetOptions {
   double birth_sigma_m = 0.1, birth_sigma_deg = 1.5;  // a hypothesis born from one image
   double ceiling_miss_cost = 4.6;                     // -2 ln 0.1, a lamp in clear view not seen
   double ceiling_spurious_cost = 6.0;                 // a lamp in full view no map lamp explains
+  // The most a map lamp's absence costs a hypothesis, over all its frames together: what one
+  // omni frame's miss costs (-2 ln 0.01, one lamp in a hundred out), so that a lamp that is out
+  // never decides alone (publish_ratio is 13.8). A lamp that is out stays out: charged in every
+  // frame that had it in view, one failed lamp of the truth's made its look-alike place, which
+  // has no lamp there, a thousand times likelier within a second, and that place was published
+  // as certain 20 m off (a 100-node building with a tenth of its lamps out; docs/hypotheses.md).
+  double lamp_out_cost = 9.2;
   // A frame's hypotheses weighed on every core (up to four), or on the calling thread only; the
   // results are the same to the last bit.
   bool weigh_in_parallel = true;
@@ -104,6 +111,9 @@ struct Hypothesis {
   double weight = 0;          // posterior share (the set's weights sum to 1)
   double last_cost = 0;       // -2 ln L of the last frame that weighed it
   bool contradicted = false;  // the last frame plainly contradicted it (never published then)
+  // What the absence of each map lamp it expected to see has cost it so far (at most
+  // HypothesisSetOptions::lamp_out_cost each).
+  std::vector<std::pair<const graph::Lamp*, double>> absences;
   const graph::Node* node = nullptr;
 };
 
