@@ -8,13 +8,17 @@
 //  - the localizer's time per camera frame while it does not know, with the live hypotheses
 //    it weighs (target: 2 ms a frame with 100 hypotheses); the 100-node kidnaps again with the
 //    hypotheses weighed and the images searched on the calling thread only (the same results,
-//    one core's time).
+//    one core's time);
+//  - unknown starts where the map is not the building: its lamps a few centimetres off, lamps
+//    it lacks, lamps out (target: 0 wrong; docs/hypotheses.md, "What is not done").
 // Each runs once (Iterations(1)); the figures are counters.
 
 #include <benchmark/benchmark.h>
 
 #include <cstdlib>
 #include <iostream>
+#include <nlohmann/json.hpp>
+#include <random>
 
 #include <string>
 
@@ -153,6 +157,54 @@ BENCHMARK(BM_UnknownStartBattery)
     ->Args({10, 20})
     ->Args({100, 20})
     ->Args({1000, 20})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+
+// Unknown starts on the 100-node building whose map is not the building as the cameras see it:
+// each map lamp moved by range(0) mm (sigma, in x and y; heights by half that), range(1) percent
+// of the lamps left out of the map (put up since it was made), range(2) percent out (dark; the
+// map has them). The draws are fixed (seed 9500).
+void BM_UnknownStartsOnAnImperfectMap(benchmark::State& state) {
+  const std::string text = sim::generate_building(test::asymmetric_building(100)).geojson;
+  const graph::TopologicalMap building = graph::parse_map(text, "generated").map;
+  std::mt19937_64 rng(9500);
+  std::normal_distribution<double> n01(0.0, 1.0);
+  std::uniform_real_distribution<double> percent(0.0, 100.0);
+  const double sigma = state.range(0) / 1000.0;
+  nlohmann::json j = nlohmann::json::parse(text);
+  for (auto& f : j["features"]) {
+    auto& props = f["properties"];
+    if (!props.contains("lampnav") || !props["lampnav"].contains("lamps")) continue;
+    nlohmann::json kept = nlohmann::json::array();
+    for (nlohmann::json l : props["lampnav"]["lamps"]) {
+      if (percent(rng) < state.range(1)) continue;
+      for (int k = 0; k < 3; ++k)
+        l["xyz"][k] = l["xyz"][k].get<double>() + (k == 2 ? 0.5 : 1.0) * sigma * n01(rng);
+      kept.push_back(l);
+    }
+    props["lampnav"]["lamps"] = kept;
+  }
+  const graph::TopologicalMap map = graph::parse_map(j.dump(), "imperfect").map;
+  test::BatteryOptions options;
+  options.world = &building;
+  for (const graph::Lamp* l : building.lamps_within(Eigen::Vector2d::Zero(), 1e9))
+    if (percent(rng) < state.range(2)) options.sensors.failed_lamps.insert(l->id.value);
+  const RobotDescription robot =
+      read_robot_description(std::string(LAMPNAV_SOURCE_DIR) + "/maps/robots/pioneer.json");
+  test::BatteryFigures f;
+  for (auto _ : state) {
+    test::Battery battery(map, robot, options);
+    std::vector<test::EpisodeResult> rs;
+    for (int k = 1; k <= 20; ++k) rs.push_back(battery.unknown_start(9500 + k));
+    f = test::figures(rs);
+  }
+  report(state, f);
+}
+BENCHMARK(BM_UnknownStartsOnAnImperfectMap)
+    ->Args({30, 0, 0})
+    ->Args({0, 5, 0})
+    ->Args({0, 0, 10})
     ->Unit(benchmark::kSecond)
     ->Iterations(1)
     ->UseRealTime();

@@ -384,6 +384,11 @@ int main(int argc, char** argv) {
   for (const auto& [n, count] : {std::pair{"10", "20"}, {"100", "20"}, {"1000", "20"}})
     add_battery(std::string("unknown starts (") + count + "), " + n + "-node building",
                 std::string("BM_UnknownStartBattery/") + n + "/" + count, false);
+  for (const auto& [args, what] : {std::pair{"30/0/0", "its lamps 3 cm off (sigma)"},
+                                   {"0/5/0", "5 % of the lamps not in it"},
+                                   {"0/0/10", "10 % of its lamps out"}})
+    add_battery(std::string("unknown starts (20), 100-node building, a map with ") + what,
+                std::string("BM_UnknownStartsOnAnImperfectMap/") + args, false);
 
   std::size_t w[5] = {4, 4, 4, 5, 6};
   for (const auto& r : rows) {

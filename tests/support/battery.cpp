@@ -104,7 +104,7 @@ struct Battery::Impl {
 
   Impl(const graph::TopologicalMap& m, const RobotDescription& r, const BatteryOptions& opt,
        const fusion::LocalizerOptions& l)
-      : map(&m), robot(r), o(opt), lo(l), sensors(m, r, opt.sensors) {
+      : map(&m), robot(r), o(opt), lo(l), sensors(opt.world ? *opt.world : m, r, opt.sensors) {
     for (const auto& n : m.nodes())
       if (n.place == graph::Place::corridor && n.axis) corridors.push_back(&n);
     sim::MapOracleOptions oo;

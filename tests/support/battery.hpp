@@ -64,6 +64,11 @@ struct BatteryOptions {
   double max_travel_m = 600.0;
   double after_fix_s = 10.0;  // driven on after the first fix, to catch a wrong one
   sim::LampSensorOptions sensors;
+  // The building as the cameras see it, when it is not the map the localizer is given: a map
+  // made with errors (lamps a few centimetres off, as `map build` or a tape leave them), or lamps
+  // added or taken away since. Same nodes as the map (the robot is driven on the map); null: the
+  // map itself. The map oracle judges on the map, as the localizer does.
+  const graph::TopologicalMap* world = nullptr;
   // Judge each drive with the map oracle, its view the lamps the omni camera places within the
   // oracle's tolerance (LampSensors::omni_resolving_radius_m).
   bool oracle = true;
