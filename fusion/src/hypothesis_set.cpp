@@ -9,6 +9,7 @@
 #include <set>
 #include <sstream>
 
+#include "lamp_absences.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/core/parallel.hpp"
 #include "lampnav/fusion/ceiling_geometry.hpp"
@@ -216,27 +217,12 @@ struct HypothesisSet::Impl {
     return std::sqrt(std::max(P(0, 0), P(1, 1)));
   }
 
-  // What the lamps a frame expected and did not see cost a hypothesis: `each` a lamp (a frame's
-  // miss), but no lamp's absences more than lamp_out_cost over the hypothesis's frames (it may be
-  // out). Recorded in the hypothesis.
-  double absence_cost(Hypothesis& h, const std::vector<const graph::Lamp*>& missed,
-                      double each) const {
-    double cost = 0;
-    for (const graph::Lamp* l : missed) {
-      auto it = std::find_if(h.absences.begin(), h.absences.end(),
-                             [&](const auto& a) { return a.first == l; });
-      if (it == h.absences.end()) it = h.absences.insert(h.absences.end(), {l, 0.0});
-      const double c = std::clamp(o.lamp_out_cost - it->second, 0.0, each);
-      it->second += c;
-      cost += c;
-    }
-    return cost;
-  }
-  // An omni score with its misses charged as absence_cost() does.
+  // An omni score with its misses charged to the hypothesis's ledger (lamp_absences.hpp).
   double omni_cost(Hypothesis& h, double score,
                    const std::vector<const graph::Lamp*>& missed) const {
     const double each = omni->options().pairs.miss_cost;
-    return score - each * static_cast<double>(missed.size()) + absence_cost(h, missed, each);
+    return score - each * static_cast<double>(missed.size()) +
+           detail::charge_absences(h.absences, missed, each, o.lamp_out_cost);
   }
 
   // What one frame says of one hypothesis: -2 ln L, and whether it plainly contradicts it (most
@@ -286,9 +272,9 @@ struct HypothesisSet::Impl {
     }
     double cost = o.ceiling_spurious_cost * unexplained;
     if (!lamps.empty())  // a dark frame says nothing of missing lamps
-      cost += absence_cost(
-          h, unseen_lamps(*map, *camera, *geometry, *kind, lamps, h.pose, h.covariance),
-          o.ceiling_miss_cost);
+      cost += detail::charge_absences(
+          h.absences, unseen_lamps(*map, *camera, *geometry, *kind, lamps, h.pose, h.covariance),
+          o.ceiling_miss_cost, o.lamp_out_cost);
     if (!labelled.empty()) {
       PoseRefusal refusal = PoseRefusal::none;
       const std::optional<PoseMeasurement> m =
@@ -395,9 +381,8 @@ struct HypothesisSet::Impl {
     h.odometry = odo.at(stamp);
     h.log_weight = log_weight;
     h.node = p.node;
-    // The image's misses, as absence_cost() charges them (births() weighs the newborn so).
-    const double miss = std::min(omni->options().pairs.miss_cost, o.lamp_out_cost);
-    for (const graph::Lamp* l : p.missed) h.absences.emplace_back(l, miss);
+    // The image's misses (births() weighs the newborn with them bounded alike).
+    detail::charge_absences(h.absences, p.missed, omni->options().pairs.miss_cost, o.lamp_out_cost);
     ++counts.born;
     return h;
   }
@@ -500,10 +485,10 @@ struct HypothesisSet::Impl {
     const double best_score = r.hypotheses.front().score;
     std::size_t n = 0;
     while (n < r.hypotheses.size() && r.hypotheses[n].score <= best_score + margin) ++n;
-    // Weighed with each lamp the image missed costing at most lamp_out_cost (absence_cost()).
-    const double miss = omni->options().pairs.miss_cost;
+    // Weighed with each lamp the image missed costing at most lamp_out_cost.
     const auto capped = [&](const PoseHypothesis& h) {
-      return h.score - (miss - std::min(miss, o.lamp_out_cost)) * h.missing;
+      return detail::with_absences_bounded(h.score, h.missing, omni->options().pairs.miss_cost,
+                                           o.lamp_out_cost);
     };
     double capped_best = capped(r.hypotheses.front());
     for (std::size_t k = 1; k < n; ++k)
