@@ -17,7 +17,6 @@
 
 #include <cstdlib>
 #include <iostream>
-#include <nlohmann/json.hpp>
 #include <random>
 
 #include <string>
@@ -169,23 +168,11 @@ void BM_UnknownStartsOnAnImperfectMap(benchmark::State& state) {
   const std::string text = sim::generate_building(test::asymmetric_building(100)).geojson;
   const graph::TopologicalMap building = graph::parse_map(text, "generated").map;
   std::mt19937_64 rng(9500);
-  std::normal_distribution<double> n01(0.0, 1.0);
   std::uniform_real_distribution<double> percent(0.0, 100.0);
-  const double sigma = state.range(0) / 1000.0;
-  nlohmann::json j = nlohmann::json::parse(text);
-  for (auto& f : j["features"]) {
-    auto& props = f["properties"];
-    if (!props.contains("lampnav") || !props["lampnav"].contains("lamps")) continue;
-    nlohmann::json kept = nlohmann::json::array();
-    for (nlohmann::json l : props["lampnav"]["lamps"]) {
-      if (percent(rng) < state.range(1)) continue;
-      for (int k = 0; k < 3; ++k)
-        l["xyz"][k] = l["xyz"][k].get<double>() + (k == 2 ? 0.5 : 1.0) * sigma * n01(rng);
-      kept.push_back(l);
-    }
-    props["lampnav"]["lamps"] = kept;
-  }
-  const graph::TopologicalMap map = graph::parse_map(j.dump(), "imperfect").map;
+  const graph::TopologicalMap map =
+      graph::parse_map(test::imperfect_map(text, state.range(0) / 1000.0, state.range(1), rng),
+                       "imperfect")
+          .map;
   test::BatteryOptions options;
   options.world = &building;
   for (const graph::Lamp* l : building.lamps_within(Eigen::Vector2d::Zero(), 1e9))
@@ -203,8 +190,10 @@ void BM_UnknownStartsOnAnImperfectMap(benchmark::State& state) {
 }
 BENCHMARK(BM_UnknownStartsOnAnImperfectMap)
     ->Args({30, 0, 0})
+    ->Args({50, 0, 0})
     ->Args({0, 5, 0})
     ->Args({0, 0, 10})
+    ->Args({30, 2, 5})
     ->Unit(benchmark::kSecond)
     ->Iterations(1)
     ->UseRealTime();

@@ -385,8 +385,10 @@ int main(int argc, char** argv) {
     add_battery(std::string("unknown starts (") + count + "), " + n + "-node building",
                 std::string("BM_UnknownStartBattery/") + n + "/" + count, false);
   for (const auto& [args, what] : {std::pair{"30/0/0", "its lamps 3 cm off (sigma)"},
+                                   {"50/0/0", "its lamps 5 cm off (sigma)"},
                                    {"0/5/0", "5 % of the lamps not in it"},
-                                   {"0/0/10", "10 % of its lamps out"}})
+                                   {"0/0/10", "10 % of its lamps out"},
+                                   {"30/2/5", "its lamps 3 cm off, 2 % not in it, 5 % out"}})
     add_battery(std::string("unknown starts (20), 100-node building, a map with ") + what,
                 std::string("BM_UnknownStartsOnAnImperfectMap/") + args, false);
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <deque>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
 
@@ -360,6 +361,26 @@ sim::BuildingOptions asymmetric_building(int nodes) {
   o.lobby = true;
   o.seed = 5;
   return o;
+}
+
+std::string imperfect_map(const std::string& geojson, double sigma_m, double unmapped_percent,
+                          std::mt19937_64& rng) {
+  std::normal_distribution<double> n01(0.0, 1.0);
+  std::uniform_real_distribution<double> percent(0.0, 100.0);
+  nlohmann::json j = nlohmann::json::parse(geojson);
+  for (auto& f : j["features"]) {
+    auto& props = f["properties"];
+    if (!props.contains("lampnav") || !props["lampnav"].contains("lamps")) continue;
+    nlohmann::json kept = nlohmann::json::array();
+    for (nlohmann::json l : props["lampnav"]["lamps"]) {
+      if (percent(rng) < unmapped_percent) continue;
+      for (int k = 0; k < 3; ++k)
+        l["xyz"][k] = l["xyz"][k].get<double>() + (k == 2 ? 0.5 : 1.0) * sigma_m * n01(rng);
+      kept.push_back(l);
+    }
+    props["lampnav"]["lamps"] = kept;
+  }
+  return j.dump();
 }
 
 }  // namespace lampnav::test

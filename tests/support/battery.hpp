@@ -101,6 +101,12 @@ std::string summarize(const std::vector<EpisodeResult>& results);
 // corridor, an east wing with another lamp spacing (2.7 m against 2.25 m), a lobby.
 sim::BuildingOptions asymmetric_building(int nodes);
 
+// A map that is not the building (BatteryOptions::world): each lamp of the GeoJSON map `geojson`
+// moved by `sigma_m` (normal, in x and y; its height by half that), and `unmapped_percent` of
+// the lamps left out, drawn from `rng`. Returns the map's GeoJSON.
+std::string imperfect_map(const std::string& geojson, double sigma_m, double unmapped_percent,
+                          std::mt19937_64& rng);
+
 // The figures of a battery: counts, and latency percentiles over the episodes that fixed.
 struct BatteryFigures {
   int episodes = 0, detected = 0, fixed = 0, correct = 0, wrong_fixes = 0;
