@@ -95,10 +95,12 @@ void GlobalLocalizer::Impl::index_lamps() {
   const LampPairOptions& q = o.pairs;
   std::map<std::pair<long, long>, int> class_ids;
   max_height = 0;
+  std::vector<double> heights;
   for (std::size_t i = 0; i < lamps.size(); ++i) {
     lamp_index[lamps[i]] = static_cast<int>(i);
     const double h = lamps[i]->xyz.z() - mount_t.z();
     max_height = std::max(max_height, h);
+    heights.push_back(h);
     const std::pair<long, long> key{std::lround(h / 0.05), std::lround(lamps[i]->length / 0.05)};
     auto it = class_ids.find(key);
     if (it == class_ids.end()) {
@@ -106,6 +108,10 @@ void GlobalLocalizer::Impl::index_lamps() {
       classes.push_back({key.first * 0.05, key.second * 0.05});
     }
     class_of.push_back(it->second);
+  }
+  if (!heights.empty()) {
+    std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
+    usual_height = heights[heights.size() / 2];
   }
   spurious_limit = spurious_blob_limit(*map, mount_t.z());
   // Two seeds lie within pair_max_theta of the axis: no further apart than twice that reach.
@@ -190,6 +196,23 @@ Vector3d GlobalLocalizer::Impl::CameraView::point(const Vector3d& lamp) const {
   return impl_->mount_Rt * (base - impl_->mount_t);
 }
 
+std::vector<StraySighting> GlobalLocalizer::Impl::stray_sightings(
+    const Pose2& pose, const Evaluation& e, const std::vector<BlobRay>& blobs) const {
+  std::vector<StraySighting> out;
+  if (!(usual_height > 0)) return out;
+  const double tilt = o.pairs.tilt_sigma_deg * kDeg, yaw = 1.0 * kDeg;
+  for (const int j : e.strays) {
+    const Vector3d d = mount_R * blobs[j].ray;  // level floor
+    if (!(d.z() > 0.01)) continue;              // below or at the lamps' horizon
+    const double t = usual_height / d.z();
+    const Vector3d base = mount_t + t * d;
+    const double distance = t * d.head<2>().norm(), slant = distance / usual_height;
+    const double reach = 3 * (tilt * usual_height * (1 + slant * slant) + yaw * distance);
+    out.push_back({pose.transform_from(base.head<2>()), reach});
+  }
+  return out;
+}
+
 std::vector<GlobalLocalizer::Impl::BlobRay> GlobalLocalizer::Impl::blob_rays(
     const vision::OmniDetection& d, double max_theta) const {
   std::vector<BlobRay> out;
@@ -236,6 +259,7 @@ struct EvaluationScratch {
   std::vector<Pair> pairs, taken, left;
   std::vector<char> explained, b_used;
   std::vector<double> blob_term, nearest;
+  std::vector<int> nearest_lamp;
   std::vector<int> first_of_lamp, first_of_blob;
   detail::RayGrid grid;
 };
@@ -290,6 +314,8 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
   blob_term.resize(blobs.size());
   std::vector<double>& nearest = x.nearest;  // each blob's least d2 to a lamp (explained ones)
   nearest.assign(blobs.size(), 9.0);
+  std::vector<int>& nearest_lamp = x.nearest_lamp;  // and its lamp (index into lamps)
+  nearest_lamp.assign(blobs.size(), -1);
   for (std::size_t j = 0; j < blobs.size(); ++j)
     blob_term[j] = 0.25 * blobs[j].angular_radius * blobs[j].angular_radius;
   detail::RayGrid& near = x.grid;
@@ -303,7 +329,10 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
       const double d2 = chord2 / s2;
       if (d2 <= 9.0) {
         explained[j] = 1;
-        nearest[j] = std::min(nearest[j], d2);
+        if (d2 < nearest[j] || nearest_lamp[j] < 0) {
+          nearest[j] = d2;
+          nearest_lamp[j] = pred[i].lamp;
+        }
         if (pred[i].z >= cos_max) pairs.push_back({d2, int(i), int(j)});
       }
     });
@@ -357,11 +386,17 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
   // matched fewer blobs would cost less: under a 4 m ceiling, with 200 blobs a frame, a twin 40 m
   // off matched 50 fewer than the truth and cost 2 to 4 less a frame.
   for (const Pair& p : taken) {
-    if (blobs[p.b].ray.z() >= cos_expect) e.cost += p.cost;
+    if (blobs[p.b].ray.z() >= cos_expect) {
+      e.cost += p.cost;
+      e.lamp_costs.emplace_back(pred[p.p].lamp, p.cost);
+    }
     e.matches.emplace_back(pred[p.p].lamp, p.b);
   }
   for (std::size_t j = 0; j < blobs.size(); ++j)
-    if (explained[j] && blobs[j].ray.z() < cos_expect) e.cost += nearest[j];
+    if (explained[j] && blobs[j].ray.z() < cos_expect) {
+      e.cost += nearest[j];
+      e.lamp_costs.emplace_back(nearest_lamp[j], nearest[j]);
+    }
   // A lamp in clear view is missing when no blob matched it; one crowded by its neighbours only
   // when no blob lies over it either: within the lamp's size and cover_sigmas of its direction's
   // sigma, widened by the blob's own size (a merged blob spans its lamps). Lamps whose blobs may
@@ -394,7 +429,8 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     }
   }
   for (std::size_t j = 0; j < blobs.size(); ++j)
-    if (!b_used[j] && !explained[j]) ++e.unexplained;
+    if (!b_used[j] && !explained[j]) e.strays.push_back(static_cast<int>(j));
+  e.unexplained = static_cast<int>(e.strays.size());
   e.cost += q.miss_cost * e.missing + q.spurious_cost * e.unexplained;
   if (tilt_sigma > 0)
     e.cost +=
@@ -539,11 +575,13 @@ PoseHypothesis GlobalLocalizer::Impl::refine(Pose2 pose, double position_sigma, 
   h.missing = e.missing;
   h.unexplained = e.unexplained;
   for (const int li : e.missed) h.missed.push_back(lamps[li]);
+  h.strays = stray_sightings(pose, e, blobs);
   for (const auto& [li, bj] : e.matches) {
     const double ang = std::acos(std::clamp(
         camera_point(pose, lamps[li]->xyz, tilt).normalized().dot(blobs[bj].ray), -1.0, 1.0));
     h.matches.push_back({lamps[li], blobs[bj].index, ang / kDeg});
   }
+  for (const auto& [li, c] : e.lamp_costs) h.lamp_costs.emplace_back(lamps[li], c);
   std::sort(h.matches.begin(), h.matches.end(),
             [](const LampMatch& a, const LampMatch& b) { return a.blob < b.blob; });
   if (tilt_out) *tilt_out = tilt;
@@ -660,7 +698,9 @@ GlobalLocalizer::PoseScore GlobalLocalizer::score(const Pose2& pose, double posi
   s.missing = e.missing;
   s.unexplained = e.unexplained;
   for (const int li : e.missed) s.missed.push_back(m.lamps[li]);
+  s.strays = m.stray_sightings(pose, e, blobs);
   s.matched = static_cast<int>(e.matches.size());
+  for (const auto& [li, c] : e.lamp_costs) s.lamp_costs.emplace_back(m.lamps[li], c);
   return s;
 }
 

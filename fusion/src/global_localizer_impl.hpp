@@ -100,7 +100,11 @@ struct Evaluation {
   double cost = std::numeric_limits<double>::infinity();
   int expected = 0, missing = 0, unexplained = 0;
   std::vector<std::pair<int, int>> matches;  // (lamp index, blob index into BlobRay list)
-  std::vector<int> missed;                   // the missing lamps (indices)
+  // What each lamp's directions added to the cost: its match in clear view, the blobs past it
+  // it is the nearest lamp of (lamp index, -2 ln L).
+  std::vector<std::pair<int, double>> lamp_costs;
+  std::vector<int> missed;  // the missing lamps (indices)
+  std::vector<int> strays;  // the blobs no lamp explains (BlobRay indices)
 };
 
 // The floor's tilt of the base (rad), a nuisance estimated with each pose.
@@ -180,8 +184,9 @@ struct GlobalLocalizer::Impl {
   // map's order, as the map's own spatial index would, without its callbacks and pointers.
   std::unordered_map<const graph::Lamp*, int> lamp_index;
   double view_radius = 0;
-  double max_height = 0;  // of a lamp above the camera
-  detail::FlatGrid grid;  // cells of half the view radius
+  double max_height = 0;    // of a lamp above the camera
+  double usual_height = 0;  // the median lamp's above the camera
+  detail::FlatGrid grid;    // cells of half the view radius
   // Cells of a metre, for the screening's "is there a lamp of this class within r of here?".
   detail::FlatGrid fine_grid;
   std::vector<Vector2d> lamp_xy;                   // per lamp
@@ -234,6 +239,9 @@ struct GlobalLocalizer::Impl {
   };
 
   std::vector<BlobRay> blob_rays(const vision::OmniDetection& d, double max_theta) const;
+  // Where the blobs no lamp explains would put a lamp at the usual height, seen from `pose`.
+  std::vector<StraySighting> stray_sightings(const Pose2& pose, const Evaluation& e,
+                                             const std::vector<BlobRay>& blobs) const;
 
   // A blob's centroid is not quite the projection of the lamp's centre (the lens bends a near
   // lamp's face unevenly): a tenth of the lamp's angular size (rad).

@@ -9,11 +9,13 @@
 #include <set>
 #include <sstream>
 
-#include "lamp_absences.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/core/parallel.hpp"
 #include "lampnav/fusion/ceiling_geometry.hpp"
+#include "lampnav/fusion/chi_square.hpp"
 #include "lampnav/vision/camera_models.hpp"
+#include "map_evidence.hpp"
+#include "map_geometry.hpp"
 #include "pose_grid.hpp"
 
 namespace lampnav::fusion {
@@ -73,6 +75,14 @@ void HypothesisSetOptions::validate() const {
   check(ceiling_miss_cost >= 0 && ceiling_spurious_cost >= 0, "ceiling_miss_cost",
         "must not be negative");
   check(lamp_out_cost >= 0, "lamp_out_cost", "must not be negative");
+  check(unmapped_lamp_cost >= 0, "unmapped_lamp_cost", "must not be negative");
+  check(stray_radius_m > 0, "stray_radius_m", "must be positive");
+  check(stray_reach_max_m >= 0, "stray_reach_max_m", "must not be negative");
+  check(map_sigma_m >= 0, "map_sigma_m", "must not be negative");
+  check(fit_gate_probability > 0 && fit_gate_probability < 1, "fit_gate_probability",
+        "must be in (0, 1)");
+  check(omni_tie_cost >= 0 && omni_tie_cost < frame_cost_cap, "omni_tie_cost",
+        "must be in [0, frame_cost_cap)");
 }
 
 struct HypothesisSet::Impl {
@@ -84,6 +94,8 @@ struct HypothesisSet::Impl {
   std::optional<vision::PinholeCamera> camera;
   std::optional<vision::LampShapePrior> kind;  // the lamps the ceiling camera looks for
   PoseMeasurementOptions measurement;
+  double lamp_height = 0;  // the map's lamps' usual height: where a stray sighting is placed
+  double fit_gate = 0;     // the ceiling fit's normalized innovation the map's errors explain
   bool has_regions = false;
 
   std::vector<Hypothesis> hs;  // best first after every frame
@@ -104,37 +116,12 @@ struct HypothesisSet::Impl {
   std::pair<Stamp, Pose2> places_at;  // the capture every place stands at, dead-reckoned pose
   mutable std::map<std::pair<int, int>, bool> twin_cache;  // by hypothesis ids
 
-  // Whether the rigid motion taking pose a to pose b maps every lamp of the map onto a lamp of
-  // the same shape and size (a rectangle's axis modulo a half turn): then the two places look
-  // alike from everywhere, whatever the robot does.
+  // Whether the rigid motion taking pose a to pose b maps the map onto itself (map_geometry.hpp):
+  // then the two places look alike from everywhere, whatever the robot does.
   bool twins(const Hypothesis& a, const Hypothesis& b) const {
     const auto key = std::minmax(a.id, b.id);
     if (const auto it = twin_cache.find(key); it != twin_cache.end()) return it->second;
-    const Pose2 T = b.pose * a.pose.inverse();
-    const double c = std::cos(T.yaw()), s = std::sin(T.yaw());
-    bool all = true;
-    for (const auto& n : map->nodes()) {
-      for (const auto& l : n.lamps) {
-        const Eigen::Vector2d p = T.translation() + Eigen::Vector2d(c * l.xyz.x() - s * l.xyz.y(),
-                                                                    s * l.xyz.x() + c * l.xyz.y());
-        bool found = false;
-        for (const graph::Lamp* m : map->lamps_within(p, 0.15)) {
-          if (m->shape != l.shape || std::abs(m->length - l.length) > 0.05 ||
-              std::abs(m->width - l.width) > 0.05 || std::abs(m->xyz.z() - l.xyz.z()) > 0.05)
-            continue;
-          const bool round = l.shape == graph::LampShape::disc || l.length <= l.width;
-          const double d = wrap_angle(m->yaw - (l.yaw + T.yaw()));
-          if (round || std::abs(std::sin(d)) < std::sin(3 * kDeg)) found = true;
-        }
-        if (!found) {
-          all = false;
-          break;
-        }
-      }
-      if (!all) break;
-    }
-    twin_cache[key] = all;
-    return all;
+    return twin_cache[key] = detail::maps_onto_itself(*map, b.pose * a.pose.inverse());
   }
 
   // Every hypothesis holding weight is a twin of the leader.
@@ -149,14 +136,25 @@ struct HypothesisSet::Impl {
        const GlobalLocalizer* g, const CeilingPipelineOptions& co, const HypothesisSetOptions& opt)
       : map(&m), o(opt), omni(g), measurement(co.measurement) {
     o.validate();
+    measurement.map_sigma = std::max(measurement.map_sigma, o.map_sigma_m);
+    fit_gate = chi_square_quantile(o.fit_gate_probability, 3);
     if (ceiling_camera) {
-      labeller.emplace(m, *ceiling_camera, co.labeller);
+      LabellerOptions lo = co.labeller;
+      lo.map_sigma = std::max(lo.map_sigma, o.map_sigma_m);
+      labeller.emplace(m, *ceiling_camera, lo);
       geometry.emplace(*ceiling_camera);
       camera.emplace(*ceiling_camera);
       kind = shape_prior_for(m, *ceiling_camera);
     }
-    for (const auto& n : m.nodes())
+    std::vector<double> heights;
+    for (const auto& n : m.nodes()) {
       if (n.region.size() >= 3) has_regions = true;
+      for (const auto& l : n.lamps) heights.push_back(l.xyz.z());
+    }
+    if (!heights.empty()) {
+      std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
+      lamp_height = heights[heights.size() / 2];
+    }
   }
 
   // Whether a pose stands in (or within the margin of) some node's region.
@@ -192,37 +190,41 @@ struct HypothesisSet::Impl {
     return c;
   }
 
-  // Kalman update of a hypothesis with a pose measurement; returns the normalized innovation
-  // squared less its expectation (3): what the measurement says against the prediction, about 0
-  // for a right hypothesis, comparable between hypotheses whatever their covariance.
+  // Kalman update of a hypothesis with a pose measurement (map_geometry.hpp), its covariance no
+  // smaller than odometry between frames allows; returns the normalized innovation squared less
+  // its expectation (3).
   double update(Hypothesis& h, const Pose2& z, const Eigen::Matrix3d& R) const {
-    const Eigen::Matrix3d S = h.covariance + R;
-    Eigen::Vector3d nu(z.x() - h.pose.x(), z.y() - h.pose.y(), wrap_angle(z.yaw() - h.pose.yaw()));
-    const Eigen::Matrix3d Si = S.inverse();
-    const Eigen::Matrix3d K = h.covariance * Si;
-    const Eigen::Vector3d dx = K * nu;
-    h.pose = Pose2(h.pose.x() + dx.x(), h.pose.y() + dx.y(), wrap_angle(h.pose.yaw() + dx.z()));
-    const Eigen::Matrix3d I_K = Eigen::Matrix3d::Identity() - K;
-    h.covariance = I_K * h.covariance * I_K.transpose() + K * R * K.transpose();
-    h.covariance = 0.5 * (h.covariance + h.covariance.transpose());
-    // A floor: a hypothesis is never surer than odometry between frames allows.
-    const double fp = o.sigma_m * o.sigma_m, fy = std::pow(o.sigma_yaw_deg * kDeg, 2);
-    if (h.covariance(0, 0) < fp) h.covariance(0, 0) = fp;
-    if (h.covariance(1, 1) < fp) h.covariance(1, 1) = fp;
-    if (h.covariance(2, 2) < fy) h.covariance(2, 2) = fy;
-    return nu.dot(Si * nu) - 3.0;
+    return detail::update_pose(h.pose, h.covariance, z, R, o.sigma_m, o.sigma_yaw_deg * kDeg);
   }
 
   static double sigma_position(const Eigen::Matrix3d& P) {
     return std::sqrt(std::max(P(0, 0), P(1, 1)));
   }
 
-  // An omni score with its misses charged to the hypothesis's ledger (lamp_absences.hpp).
-  double omni_cost(Hypothesis& h, double score,
-                   const std::vector<const graph::Lamp*>& missed) const {
+  // The omni strays placed well enough to be charged to a spot.
+  int placed_strays(const std::vector<StraySighting>& strays) const {
+    return static_cast<int>(
+        std::count_if(strays.begin(), strays.end(),
+                      [&](const StraySighting& b) { return b.reach <= o.stray_reach_max_m; }));
+  }
+
+  // An omni score with its misses and its strays charged to the hypothesis's ledgers
+  // (map_evidence.hpp).
+  double omni_cost(Hypothesis& h, double score, const std::vector<const graph::Lamp*>& missed,
+                   const std::vector<StraySighting>& strays,
+                   const std::vector<std::pair<const graph::Lamp*, double>>& lamp_costs) const {
     const double each = omni->options().pairs.miss_cost;
-    return score - each * static_cast<double>(missed.size()) +
-           detail::charge_absences(h.absences, missed, each, o.lamp_out_cost);
+    const double stray = omni->options().pairs.spurious_cost;
+    double cost = score - each * static_cast<double>(missed.size()) +
+                  detail::charge_absences(h.map_costs.lamps, missed, each, o.lamp_out_cost);
+    for (const StraySighting& b : strays)
+      if (b.reach <= o.stray_reach_max_m)
+        cost += detail::charge_stray(h.map_costs.strays, b.at, std::max(o.stray_radius_m, b.reach),
+                                     stray, o.unmapped_lamp_cost) -
+                stray;
+    for (const auto& [l, c] : lamp_costs)
+      cost += detail::charge_misfit(h.map_costs.misfits, l, c, o.lamp_out_cost) - c;
+    return cost;
   }
 
   // What one frame says of one hypothesis: -2 ln L, and whether it plainly contradicts it (most
@@ -246,20 +248,36 @@ struct HypothesisSet::Impl {
                                       o.omni_bump_sigma_m * o.omni_bump_sigma_m,
                                       std::pow(o.omni_bump_sigma_deg * kDeg, 2));
       const int seen = static_cast<int>(r->matches.size()) + r->unexplained;
-      return {omni_cost(h, r->score, r->missed) + update(h, r->pose, R),
+      // A misfit better than expected says nothing (map_evidence.hpp, charge_misfit).
+      return {omni_cost(h, r->score, r->missed, r->strays, r->lamp_costs) +
+                  std::max(0.0, update(h, r->pose, R)),
               contradicts(r->expected, r->missing, seen, r->unexplained)};
     }
     // Nothing to refine on: the prediction scored as it stands, with its own uncertainty.
     const GlobalLocalizer::PoseScore sc = omni->score(h.pose, ps, ys, d);
-    return {omni_cost(h, sc.cost, sc.missed),
+    return {omni_cost(h, sc.cost, sc.missed, sc.strays, sc.lamp_costs),
             contradicts(sc.expected, sc.missing, sc.matched + sc.unexplained, sc.unexplained)};
+  }
+
+  // A lamp in full view the labeller found no map lamp for. Near a map lamp, that lamp is off
+  // by more than the gate: its misfit. Elsewhere, a lamp the map does not have: its spot.
+  double unlabelled(Hypothesis& h, const vision::LampDetection& d) const {
+    const std::optional<Eigen::Vector2d> base = geometry->base_point(d.centre, lamp_height);
+    if (!base) return o.ceiling_spurious_cost;
+    const Eigen::Vector2d at = h.pose.transform_from(*base);
+    const std::vector<const graph::Lamp*> near = map->lamps_within(at, o.stray_radius_m);
+    if (!near.empty())
+      return detail::charge_account(detail::account_of(h.map_costs.misfits, near.front()),
+                                    o.ceiling_spurious_cost, o.lamp_out_cost);
+    return detail::charge_stray(h.map_costs.strays, at, o.stray_radius_m, o.ceiling_spurious_cost,
+                                o.unmapped_lamp_cost);
   }
 
   // A ceiling frame for one hypothesis (carried to the frame), updating it.
   Weighed weigh_ceiling(Hypothesis& h, const std::vector<vision::LampDetection>& lamps) const {
     std::vector<LabelledLamp> labelled;
     std::set<LampId> taken;
-    int unexplained = 0;
+    double cost = 0;
     for (const auto& d : lamps) {
       if (d.view == vision::LampView::partial) continue;
       const LabelResult r = labeller->label(d, h.pose, h.covariance, taken);
@@ -267,34 +285,44 @@ struct HypothesisSet::Impl {
         labelled.push_back({r.lamp, d});
         taken.insert(r.lamp->id);
       } else if (r.outcome == LabelOutcome::no_candidate) {
-        ++unexplained;
+        cost += unlabelled(h, d);
       }
     }
-    double cost = o.ceiling_spurious_cost * unexplained;
     if (!lamps.empty())  // a dark frame says nothing of missing lamps
       cost += detail::charge_absences(
-          h.absences, unseen_lamps(*map, *camera, *geometry, *kind, lamps, h.pose, h.covariance),
+          h.map_costs.lamps,
+          unseen_lamps(*map, *camera, *geometry, *kind, lamps, h.pose, h.covariance),
           o.ceiling_miss_cost, o.lamp_out_cost);
     if (!labelled.empty()) {
       PoseRefusal refusal = PoseRefusal::none;
       const std::optional<PoseMeasurement> m =
           measure_pose(*geometry, camera->parameters().fx, labelled, h.pose, Stamp{}, measurement,
                        nullptr, &refusal);
-      if (m)
-        cost += update(h, m->pose, m->covariance);
-      else if (refusal == PoseRefusal::labels_disagree)
+      // The ceiling camera places a lamp to a few millimetres, so a fit's misfit is mostly the
+      // map's error (a lamp a few centimetres off), the same in every frame: counted, it made
+      // one of two look-alike places certain within a second. Only a misfit past what the map's
+      // errors explain (fit_gate) says the hypothesis is off, charged to the lamps it was fit to.
+      if (m) {
+        const double misfit = update(h, m->pose, m->covariance) + 3.0 - fit_gate;
+        if (misfit > 0) {
+          std::vector<const graph::Lamp*> from;
+          for (const LabelledLamp& l : labelled) from.push_back(l.lamp);
+          cost += detail::charge_fit(h.map_costs.misfits, from, misfit, o.lamp_out_cost);
+        }
+      } else if (refusal == PoseRefusal::labels_disagree)
         cost += o.ceiling_spurious_cost;
     }
     return {cost, false};
   }
 
   // Carries every hypothesis to `stamp`, kills those that went through a wall, and weighs each
-  // with `weigh`; the costs of one frame are taken relative to the best and capped. Returns
+  // with `weigh`; the costs of one frame are taken relative to the best, less `tie`, and capped.
+  // Returns
   // whether the frame contradicted every hypothesis. The hypotheses are weighed on every core
   // (each alone, so the result does not depend on how many): a frame with a hundred of them is
   // a few milliseconds of work.
   template <class Weigh>
-  bool weigh_all(Stamp stamp, const OdometryTrack& odo, double cap, Weigh weigh) {
+  bool weigh_all(Stamp stamp, const OdometryTrack& odo, double cap, double tie, Weigh weigh) {
     std::vector<Hypothesis> next;
     next.reserve(hs.size());
     for (const Hypothesis& h : hs) {
@@ -318,7 +346,7 @@ struct HypothesisSet::Impl {
     for (std::size_t k = 0; k < next.size(); ++k) {
       next[k].last_cost = weighed[k].cost;
       next[k].contradicted = weighed[k].contradicted;
-      next[k].log_weight -= 0.5 * std::min(cap, weighed[k].cost - best);
+      next[k].log_weight -= 0.5 * std::min(cap, std::max(0.0, weighed[k].cost - best - tie));
       next[k].node = map->node_containing(next[k].pose.translation());
     }
     hs = std::move(next);
@@ -382,7 +410,14 @@ struct HypothesisSet::Impl {
     h.log_weight = log_weight;
     h.node = p.node;
     // The image's misses (births() weighs the newborn with them bounded alike).
-    detail::charge_absences(h.absences, p.missed, omni->options().pairs.miss_cost, o.lamp_out_cost);
+    detail::charge_absences(h.map_costs.lamps, p.missed, omni->options().pairs.miss_cost,
+                            o.lamp_out_cost);
+    for (const auto& [l, c] : p.lamp_costs)
+      detail::charge_misfit(h.map_costs.misfits, l, c, o.lamp_out_cost);
+    for (const StraySighting& b : p.strays)
+      if (b.reach <= o.stray_reach_max_m)
+        detail::charge_stray(h.map_costs.strays, b.at, std::max(o.stray_radius_m, b.reach),
+                             omni->options().pairs.spurious_cost, o.unmapped_lamp_cost);
     ++counts.born;
     return h;
   }
@@ -485,10 +520,13 @@ struct HypothesisSet::Impl {
     const double best_score = r.hypotheses.front().score;
     std::size_t n = 0;
     while (n < r.hypotheses.size() && r.hypotheses[n].score <= best_score + margin) ++n;
-    // Weighed with each lamp the image missed costing at most lamp_out_cost.
+    // Weighed with each lamp the image missed costing at most lamp_out_cost, each blob no lamp
+    // explains at most unmapped_lamp_cost.
     const auto capped = [&](const PoseHypothesis& h) {
-      return detail::with_absences_bounded(h.score, h.missing, omni->options().pairs.miss_cost,
-                                           o.lamp_out_cost);
+      const auto& q = omni->options().pairs;
+      return detail::with_each_bounded(
+          detail::with_each_bounded(h.score, h.missing, q.miss_cost, o.lamp_out_cost),
+          placed_strays(h.strays), q.spurious_cost, o.unmapped_lamp_cost);
     };
     double capped_best = capped(r.hypotheses.front());
     for (std::size_t k = 1; k < n; ++k)
@@ -618,8 +656,9 @@ void HypothesisSet::omni(Stamp stamp, const vision::OmniDetection& d,
                        [](const Hypothesis& h) { return h.origin != HypothesisOrigin::kept; }),
         m.hs.end());
   if (!m.hs.empty()) {
-    const bool all_contradicted = m.weigh_all(stamp, odometry, m.o.frame_cost_cap,
-                                              [&](Hypothesis& h) { return m.weigh_omni(h, d); });
+    const bool all_contradicted =
+        m.weigh_all(stamp, odometry, m.o.frame_cost_cap, m.o.omni_tie_cost,
+                    [&](Hypothesis& h) { return m.weigh_omni(h, d); });
     if (m.complete) ++m.omni_frames;
     m.tidy();
     // Every hypothesis contradicted: the robot is none of them (carried away again, or the set
@@ -639,7 +678,7 @@ void HypothesisSet::ceiling(Stamp stamp, const std::vector<vision::LampDetection
   Impl& m = *impl_;
   // Until the places are all known the omni frames do the weighing (see omni()).
   if (!m.labeller || m.hs.empty() || !m.complete) return;
-  m.weigh_all(stamp, odometry, m.o.ceiling_cost_cap,
+  m.weigh_all(stamp, odometry, m.o.ceiling_cost_cap, 0.0,
               [&](Hypothesis& h) { return m.weigh_ceiling(h, lamps); });
   m.tidy();
   if (m.complete && m.hs.empty()) m.reset("every hypothesis went through a wall");

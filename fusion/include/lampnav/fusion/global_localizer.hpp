@@ -111,6 +111,14 @@ struct LampMatch {
   double error_deg = 0;  // angle between the predicted and the seen direction
 };
 
+// A blob no lamp explains, placed in the map at the lamps' usual height as seen from a pose: where
+// a lamp the map lacks would be.
+struct StraySighting {
+  Eigen::Vector2d at = Eigen::Vector2d::Zero();
+  double reach = 0;  // how far off `at` it may be (m): the floor's tilt and the pose's yaw
+                     // through the ray's slope, three sigmas
+};
+
 struct PoseHypothesis {
   Pose2 pose;                                                // robot base in the map
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();  // x, y, yaw
@@ -122,7 +130,12 @@ struct PoseHypothesis {
   int unexplained = 0;  // blobs no lamp explains
   std::vector<LampMatch> matches;
   std::vector<const graph::Lamp*> missed;  // the lamps in clear view not seen
-  const graph::Node* node = nullptr;       // the node whose region holds the pose
+  std::vector<StraySighting> strays;       // the blobs no lamp explains, where the ray reaches
+                                           // the lamps' height
+  // What each lamp's directions added to the score: its match in clear view, and past it the
+  // blobs it is the nearest lamp of (-2 ln L; a lamp may appear more than once).
+  std::vector<std::pair<const graph::Lamp*, double>> lamp_costs;
+  const graph::Node* node = nullptr;  // the node whose region holds the pose
 };
 
 struct GlobalLocalization {
@@ -193,6 +206,8 @@ class GlobalLocalizer {
     double cost = 0;
     int expected = 0, missing = 0, unexplained = 0, matched = 0;
     std::vector<const graph::Lamp*> missed;  // the lamps in clear view not seen
+    std::vector<StraySighting> strays;       // as PoseHypothesis::strays
+    std::vector<std::pair<const graph::Lamp*, double>> lamp_costs;  // as PoseHypothesis's
   };
   PoseScore score(const Pose2& pose, double position_sigma, double yaw_sigma,
                   const vision::OmniDetection& detection) const;

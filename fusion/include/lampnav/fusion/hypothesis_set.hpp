@@ -65,13 +65,16 @@ struct HypothesisSetOptions {
   // slows the pruning: on the 1,000-node kidnaps, 4.6 fixed 5 of 10 and 2 fixed 9 of 10 after
   // a median of 163 m, against 9 of 10 after 108 m with none (docs/hypotheses.md).
   double place_allowance = 0.0;
-  double drop_ratio = 1e-9;               // hypotheses below this likelihood ratio to the best die
-  double birth_ratio = 1e-4;              // an image gives birth to the places within this ratio of
-                                          // its best (the truth's own noise stays far inside it)
-  double frame_cost_cap = 12.0;           // -2 ln L one omni frame can cost a hypothesis: one odd
-                                          // frame (a person under a lamp) never decides alone
-  double ceiling_cost_cap = 2.0;          // the same for a ceiling frame: ten a second see the same
-                                          // lamps, so their evidence is far from independent
+  double drop_ratio = 1e-9;      // hypotheses below this likelihood ratio to the best die
+  double birth_ratio = 1e-4;     // an image gives birth to the places within this ratio of
+                                 // its best (the truth's own noise stays far inside it)
+  double frame_cost_cap = 12.0;  // -2 ln L one omni frame can cost a hypothesis: one odd
+                                 // frame (a person under a lamp) never decides alone
+  // The same for a ceiling frame: ten a second see the same lamps, so their evidence is far from
+  // independent. What repeats (a lamp out, off, or not in the map) is counted once by the
+  // ledgers (MapErrorCosts); at 2, the first frame that saw a lamp off lost two thirds of what it
+  // said, and a building's four turned images stayed in the set.
+  double ceiling_cost_cap = 6.0;
   double kept_prior = 0.1;                // the tracking hypothesis's prior after a kidnap alarm
   double merge_m = 0.3, merge_deg = 5.0;  // hypotheses closer than this are one
   // Odometry error while carried: position sigma grows by sigma_per_m per metre travelled, yaw
@@ -84,17 +87,58 @@ struct HypothesisSetOptions {
   double birth_sigma_m = 0.1, birth_sigma_deg = 1.5;  // a hypothesis born from one image
   double ceiling_miss_cost = 4.6;                     // -2 ln 0.1, a lamp in clear view not seen
   double ceiling_spurious_cost = 6.0;                 // a lamp in full view no map lamp explains
-  // The most a map lamp's absence costs a hypothesis, over all its frames together: what one
-  // omni frame's miss costs (-2 ln 0.01, one lamp in a hundred out), so that a lamp that is out
-  // never decides alone (publish_ratio is 13.8). A lamp that is out stays out: charged in every
-  // frame that had it in view, one failed lamp of the truth's made its look-alike place, which
-  // has no lamp there, a thousand times likelier within a second, and that place was published
-  // as certain 20 m off (a 100-node building with a tenth of its lamps out; docs/hypotheses.md).
+  // A map is not the building (fusion/src/map_evidence.hpp). The most a map lamp's absences and
+  // misfits cost a hypothesis, over all its frames together: what one omni frame's miss costs
+  // (-2 ln 0.01, one lamp in a hundred out), so that a lamp that is out, or off, never decides
+  // alone (publish_ratio is 13.8). A lamp that is out stays out: charged in every frame that had
+  // it in view, one failed lamp of the truth's made its look-alike place, which has no lamp
+  // there, a thousand times likelier within a second, and that place was published as certain
+  // 20 m off (a 100-node building with a tenth of its lamps out; docs/hypotheses.md).
   double lamp_out_cost = 9.2;
+  // The same for a spot where lamps are seen and the map has none (a lamp put up since, one the
+  // survey missed), by both cameras together: sightings within stray_radius_m of one another
+  // (widened with the distance for the omni camera's far blobs) are one spot.
+  double unmapped_lamp_cost = 9.2;
+  double stray_radius_m = 0.5;
+  // An omni blob no lamp explains counts as a spot only where it places a lamp within this (m,
+  // StraySighting::reach); further out, as before, in every image. A map of part of a building
+  // leaves the omni camera dozens of far blobs each image: merged into wide spots, they cost the
+  // places too little to tell a pose 17 cm and 6 degrees off from the tracked one.
+  double stray_reach_max_m = 1.0;
+  // How far the map's lamps may be off the building's (m), in the set's labelling and pose fits:
+  // `map build` leaves 2 to 4 cm (docs/mapping.md). The tracking filter keeps the ceiling
+  // pipeline's own, tighter, figure.
+  double map_sigma_m = 0.03;
+  // A ceiling frame's pose fit costs a hypothesis only past this quantile of its chi-square (3
+  // degrees of freedom; with map_sigma_m in it): within it, the misfit is the map's errors. A
+  // hypothesis 17 cm and 6 degrees off, born from one omni image beside the tracked pose, pays.
+  double fit_gate_probability = 0.99;
+  // An omni frame's cost within this of the best frame's is a tie. What a map's errors leave in
+  // an image after each lamp is counted once (its far blobs, the tilt each image fits): on a map
+  // 5 cm off, 0.2 to 1.5 an image against the truth, image after image, which published a twin
+  // 20 m off after 40 m (docs/hypotheses.md).
+  double omni_tie_cost = 1.0;
   // A frame's hypotheses weighed on every core (up to four), or on the calling thread only; the
   // results are the same to the last bit.
   bool weigh_in_parallel = true;
   void validate() const;  // throws InputError naming the field
+};
+
+// What a map that is not the building has cost one hypothesis so far, each error bounded over
+// all its frames together (fusion/src/map_evidence.hpp says why).
+struct MapErrorCosts {
+  // Each map lamp's absences (at most HypothesisSetOptions::lamp_out_cost each, in all).
+  std::vector<std::pair<const graph::Lamp*, double>> lamps;
+  // Each map lamp's misfit: the worst a frame found it off, or seen where the gate would not
+  // label it (at most lamp_out_cost each).
+  std::vector<std::pair<const graph::Lamp*, double>> misfits;
+  // Each spot where lamps were seen and the map has none (at most unmapped_lamp_cost each).
+  struct Stray {
+    Eigen::Vector2d at = Eigen::Vector2d::Zero();  // in the map, at the lamps' usual height
+    double radius = 0;                             // sightings within it are the same spot
+    double spent = 0;
+  };
+  std::vector<Stray> strays;
 };
 
 enum class HypothesisOrigin { omni, kept };  // born from an omni image; the tracking estimate
@@ -111,9 +155,7 @@ struct Hypothesis {
   double weight = 0;          // posterior share (the set's weights sum to 1)
   double last_cost = 0;       // -2 ln L of the last frame that weighed it
   bool contradicted = false;  // the last frame plainly contradicted it (never published then)
-  // What the absence of each map lamp it expected to see has cost it so far (at most
-  // HypothesisSetOptions::lamp_out_cost each).
-  std::vector<std::pair<const graph::Lamp*, double>> absences;
+  MapErrorCosts map_costs;    // what the map's errors have cost it so far
   const graph::Node* node = nullptr;
 };
 
