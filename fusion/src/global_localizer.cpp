@@ -269,7 +269,7 @@ thread_local EvaluationScratch scratch;
 
 GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     const Pose2& pose, const Tilt& tilt, double position_sigma, double yaw_sigma, double tilt_sigma,
-    const std::vector<BlobRay>& blobs, double screen_theta) const {
+    const std::vector<BlobRay>& blobs, double screen_theta, bool itemized) const {
   const LampPairOptions& q = o.pairs;
   const double max_theta = screen_theta > 0 ? screen_theta : q.max_theta_deg * kDeg;
   const double expect_theta = screen_theta > 0 ? screen_theta : q.expect_max_theta_deg * kDeg;
@@ -388,14 +388,14 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
   for (const Pair& p : taken) {
     if (blobs[p.b].ray.z() >= cos_expect) {
       e.cost += p.cost;
-      e.lamp_costs.emplace_back(pred[p.p].lamp, p.cost);
+      if (itemized) e.lamp_costs.emplace_back(pred[p.p].lamp, p.cost);
     }
     e.matches.emplace_back(pred[p.p].lamp, p.b);
   }
   for (std::size_t j = 0; j < blobs.size(); ++j)
     if (explained[j] && blobs[j].ray.z() < cos_expect) {
       e.cost += nearest[j];
-      e.lamp_costs.emplace_back(nearest_lamp[j], nearest[j]);
+      if (itemized) e.lamp_costs.emplace_back(nearest_lamp[j], nearest[j]);
     }
   // A lamp in clear view is missing when no blob matched it; one crowded by its neighbours only
   // when no blob lies over it either: within the lamp's size and cover_sigmas of its direction's
@@ -429,8 +429,10 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     }
   }
   for (std::size_t j = 0; j < blobs.size(); ++j)
-    if (!b_used[j] && !explained[j]) e.strays.push_back(static_cast<int>(j));
-  e.unexplained = static_cast<int>(e.strays.size());
+    if (!b_used[j] && !explained[j]) {
+      ++e.unexplained;
+      if (itemized) e.strays.push_back(static_cast<int>(j));
+    }
   e.cost += q.miss_cost * e.missing + q.spurious_cost * e.unexplained;
   if (tilt_sigma > 0)
     e.cost +=
@@ -566,7 +568,7 @@ PoseHypothesis GlobalLocalizer::Impl::refine(Pose2 pose, double position_sigma, 
     }
   }
   // Scored with one common tolerance, so hypotheses compare.
-  e = evaluate(pose, tilt, 0.05, 0.5 * kDeg, ts, blobs);
+  e = evaluate(pose, tilt, 0.05, 0.5 * kDeg, ts, blobs, 0, true);
   PoseHypothesis h;
   h.pose = pose;
   h.covariance = cov;
@@ -692,7 +694,7 @@ GlobalLocalizer::PoseScore GlobalLocalizer::score(const Pose2& pose, double posi
   const std::vector<BlobRay> blobs = m.blob_rays(d, m.o.pairs.max_theta_deg * kDeg);
   const Evaluation e =
       m.evaluate(pose, {}, std::max(1e-3, position_sigma), std::max(1e-4, yaw_sigma),
-                 m.o.pairs.tilt_sigma_deg * kDeg, blobs);
+                 m.o.pairs.tilt_sigma_deg * kDeg, blobs, 0, true);
   s.cost = e.cost;
   s.expected = e.expected;
   s.missing = e.missing;

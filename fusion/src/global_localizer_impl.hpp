@@ -98,8 +98,8 @@ class RayGrid {
 // One pose scored against the blobs.
 struct Evaluation {
   double cost = std::numeric_limits<double>::infinity();
-  int expected = 0, missing = 0, unexplained = 0;
-  std::vector<std::pair<int, int>> matches;  // (lamp index, blob index into BlobRay list)
+  int expected = 0, missing = 0, unexplained = 0;  // (itemized or not)
+  std::vector<std::pair<int, int>> matches;        // (lamp index, blob index into BlobRay list)
   // What each lamp's directions added to the cost: its match in clear view, the blobs past it
   // it is the nearest lamp of (lamp index, -2 ln L).
   std::vector<std::pair<int, double>> lamp_costs;
@@ -254,10 +254,12 @@ struct GlobalLocalizer::Impl {
   // Scores a pose known within (position_sigma, yaw_sigma) and a floor tilt known within
   // tilt_sigma: predicted lamps matched one-to-one to blobs, nearest first, within 3 sigma.
   // With `screen_theta` (rad) only lamps within it of the axis are predicted and expected: a
-  // cheaper screening of many candidates with the blobs of that cone.
+  // cheaper screening of many candidates with the blobs of that cone. `itemized`: the cost's
+  // items too (Evaluation::lamp_costs, strays), for the scores a hypothesis set weighs; the
+  // screening and the rounds of least squares, thousands of calls an image, go without.
   Evaluation evaluate(const Pose2& pose, const Tilt& tilt, double position_sigma, double yaw_sigma,
-                      double tilt_sigma, const std::vector<BlobRay>& blobs,
-                      double screen_theta = 0) const;
+                      double tilt_sigma, const std::vector<BlobRay>& blobs, double screen_theta = 0,
+                      bool itemized = false) const;
 
   struct Solution {
     Pose2 pose;

@@ -25,66 +25,6 @@ constexpr double kDeg = M_PI / 180.0;
 constexpr double kNegInf = -std::numeric_limits<double>::infinity();
 }  // namespace
 
-const char* to_string(HypothesisOrigin o) { return o == HypothesisOrigin::kept ? "kept" : "omni"; }
-
-const char* to_string(HypothesisVerdict v) {
-  switch (v) {
-    case HypothesisVerdict::empty:
-      return "empty";
-    case HypothesisVerdict::incomplete:
-      return "incomplete";
-    case HypothesisVerdict::ambiguous:
-      return "ambiguous";
-    case HypothesisVerdict::symmetric:
-      return "symmetric";
-    case HypothesisVerdict::decided:
-      return "decided";
-  }
-  return "?";
-}
-
-void HypothesisSetOptions::validate() const {
-  auto check = [](bool ok, const char* field, const char* what) {
-    if (!ok) throw InputError({"", "hypothesis set options", field}, what);
-  };
-  check(publish_posterior > 0.5 && publish_posterior < 1, "publish_posterior",
-        "must be between 0.5 and 1");
-  check(publish_ratio >= 1, "publish_ratio", "must be at least 1");
-  check(min_omni_frames >= 1, "min_omni_frames", "must be at least 1");
-  check(max_hypotheses >= 1 && max_hypotheses <= 100000, "max_hypotheses", "must be 1 to 100000");
-  check(place_gate_m > 0 && place_gate_deg > 0, "place_gate_m", "must be positive");
-  check(place_cost_max >= frame_cost_cap, "place_cost_max", "must be at least frame_cost_cap");
-  check(place_allowance >= 0 && place_allowance < frame_cost_cap, "place_allowance",
-        "must be in [0, frame_cost_cap)");
-  check(drop_ratio > 0 && drop_ratio < 1e-3, "drop_ratio", "must be in (0, 0.001)");
-  check(birth_ratio >= drop_ratio && birth_ratio < 1, "birth_ratio", "must be in [drop_ratio, 1)");
-  check(symmetry_check_max >= 2, "symmetry_check_max", "must be at least 2");
-  check(station_m >= 0, "station_m", "must not be negative");
-  check(enumerate_every_m >= 0 && enumerate_every_deg >= 0, "enumerate_every_m",
-        "must not be negative");
-  check(frame_cost_cap > 0, "frame_cost_cap", "must be positive");
-  check(ceiling_cost_cap > 0, "ceiling_cost_cap", "must be positive");
-  check(birth_sigma_m > 0 && birth_sigma_deg > 0, "birth_sigma_m", "must be positive");
-  check(kept_prior > 0 && kept_prior < 1, "kept_prior", "must be in (0, 1)");
-  check(merge_m > 0 && merge_deg > 0, "merge_m", "must be positive");
-  check(sigma_m > 0 && sigma_per_m >= 0 && sigma_yaw_deg > 0 && sigma_yaw_deg_per_m >= 0, "sigma_m",
-        "odometry sigmas must be positive");
-  check(wall_margin_m >= 0, "wall_margin_m", "must not be negative");
-  check(omni_bump_sigma_m >= 0 && omni_bump_sigma_deg >= 0, "omni_bump_sigma_m",
-        "must not be negative");
-  check(ceiling_miss_cost >= 0 && ceiling_spurious_cost >= 0, "ceiling_miss_cost",
-        "must not be negative");
-  check(lamp_out_cost >= 0, "lamp_out_cost", "must not be negative");
-  check(unmapped_lamp_cost >= 0, "unmapped_lamp_cost", "must not be negative");
-  check(stray_radius_m > 0, "stray_radius_m", "must be positive");
-  check(stray_reach_max_m >= 0, "stray_reach_max_m", "must not be negative");
-  check(map_sigma_m >= 0, "map_sigma_m", "must not be negative");
-  check(fit_gate_probability > 0 && fit_gate_probability < 1, "fit_gate_probability",
-        "must be in (0, 1)");
-  check(omni_tie_cost >= 0 && omni_tie_cost < frame_cost_cap, "omni_tie_cost",
-        "must be in [0, frame_cost_cap)");
-}
-
 struct HypothesisSet::Impl {
   const graph::TopologicalMap* map;
   HypothesisSetOptions o;
@@ -94,8 +34,10 @@ struct HypothesisSet::Impl {
   std::optional<vision::PinholeCamera> camera;
   std::optional<vision::LampShapePrior> kind;  // the lamps the ceiling camera looks for
   PoseMeasurementOptions measurement;
-  double lamp_height = 0;  // the map's lamps' usual height: where a stray sighting is placed
-  double fit_gate = 0;     // the ceiling fit's normalized innovation the map's errors explain
+  // Where a stray ceiling sighting is placed: the usual height of the lamps the ceiling camera
+  // looks for (their shape prior's nominal distance, above the floor).
+  double lamp_height = 0;
+  double fit_gate = 0;  // the ceiling fit's normalized innovation the map's errors explain
   bool has_regions = false;
 
   std::vector<Hypothesis> hs;  // best first after every frame
@@ -145,16 +87,10 @@ struct HypothesisSet::Impl {
       geometry.emplace(*ceiling_camera);
       camera.emplace(*ceiling_camera);
       kind = shape_prior_for(m, *ceiling_camera);
+      lamp_height = kind->nominal_distance + ceiling_camera->mount.xyz.z();
     }
-    std::vector<double> heights;
-    for (const auto& n : m.nodes()) {
+    for (const auto& n : m.nodes())
       if (n.region.size() >= 3) has_regions = true;
-      for (const auto& l : n.lamps) heights.push_back(l.xyz.z());
-    }
-    if (!heights.empty()) {
-      std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
-      lamp_height = heights[heights.size() / 2];
-    }
   }
 
   // Whether a pose stands in (or within the margin of) some node's region.
@@ -208,23 +144,25 @@ struct HypothesisSet::Impl {
                       [&](const StraySighting& b) { return b.reach <= o.stray_reach_max_m; }));
   }
 
-  // An omni score with its misses and its strays charged to the hypothesis's ledgers
-  // (map_evidence.hpp).
-  double omni_cost(Hypothesis& h, double score, const std::vector<const graph::Lamp*>& missed,
-                   const std::vector<StraySighting>& strays,
-                   const std::vector<std::pair<const graph::Lamp*, double>>& lamp_costs) const {
+  // Charges what an omni image said of a hypothesis to its ledgers (map_evidence.hpp): the lamps
+  // it missed, its blobs no lamp explains placed well enough for a spot, what each lamp's
+  // directions cost. Returns what the ledgers charged less what the image's score counted for
+  // them in full.
+  double charge_image(Hypothesis& h, const std::vector<const graph::Lamp*>& missed,
+                      const std::vector<StraySighting>& strays,
+                      const std::vector<std::pair<const graph::Lamp*, double>>& lamp_costs) const {
     const double each = omni->options().pairs.miss_cost;
     const double stray = omni->options().pairs.spurious_cost;
-    double cost = score - each * static_cast<double>(missed.size()) +
-                  detail::charge_absences(h.map_costs.lamps, missed, each, o.lamp_out_cost);
+    double delta = detail::charge_absences(h.map_costs.lamps, missed, each, o.lamp_out_cost) -
+                   each * static_cast<double>(missed.size());
     for (const StraySighting& b : strays)
       if (b.reach <= o.stray_reach_max_m)
-        cost += detail::charge_stray(h.map_costs.strays, b.at, std::max(o.stray_radius_m, b.reach),
-                                     stray, o.unmapped_lamp_cost) -
-                stray;
+        delta += detail::charge_stray(h.map_costs.strays, b.at, std::max(o.stray_radius_m, b.reach),
+                                      stray, o.unmapped_lamp_cost) -
+                 stray;
     for (const auto& [l, c] : lamp_costs)
-      cost += detail::charge_misfit(h.map_costs.misfits, l, c, o.lamp_out_cost) - c;
-    return cost;
+      delta += detail::charge_misfit(h.map_costs.misfits, l, c, o.lamp_out_cost) - c;
+    return delta;
   }
 
   // What one frame says of one hypothesis: -2 ln L, and whether it plainly contradicts it (most
@@ -249,13 +187,13 @@ struct HypothesisSet::Impl {
                                       std::pow(o.omni_bump_sigma_deg * kDeg, 2));
       const int seen = static_cast<int>(r->matches.size()) + r->unexplained;
       // A misfit better than expected says nothing (map_evidence.hpp, charge_misfit).
-      return {omni_cost(h, r->score, r->missed, r->strays, r->lamp_costs) +
+      return {r->score + charge_image(h, r->missed, r->strays, r->lamp_costs) +
                   std::max(0.0, update(h, r->pose, R)),
               contradicts(r->expected, r->missing, seen, r->unexplained)};
     }
     // Nothing to refine on: the prediction scored as it stands, with its own uncertainty.
     const GlobalLocalizer::PoseScore sc = omni->score(h.pose, ps, ys, d);
-    return {omni_cost(h, sc.cost, sc.missed, sc.strays, sc.lamp_costs),
+    return {sc.cost + charge_image(h, sc.missed, sc.strays, sc.lamp_costs),
             contradicts(sc.expected, sc.missing, sc.matched + sc.unexplained, sc.unexplained)};
   }
 
@@ -317,9 +255,8 @@ struct HypothesisSet::Impl {
 
   // Carries every hypothesis to `stamp`, kills those that went through a wall, and weighs each
   // with `weigh`; the costs of one frame are taken relative to the best, less `tie`, and capped.
-  // Returns
-  // whether the frame contradicted every hypothesis. The hypotheses are weighed on every core
-  // (each alone, so the result does not depend on how many): a frame with a hundred of them is
+  // Returns whether the frame contradicted every hypothesis. The hypotheses are weighed on every
+  // core (each alone, so the result does not depend on how many): a frame with a hundred of them is
   // a few milliseconds of work.
   template <class Weigh>
   bool weigh_all(Stamp stamp, const OdometryTrack& odo, double cap, double tie, Weigh weigh) {
@@ -409,15 +346,8 @@ struct HypothesisSet::Impl {
     h.odometry = odo.at(stamp);
     h.log_weight = log_weight;
     h.node = p.node;
-    // The image's misses (births() weighs the newborn with them bounded alike).
-    detail::charge_absences(h.map_costs.lamps, p.missed, omni->options().pairs.miss_cost,
-                            o.lamp_out_cost);
-    for (const auto& [l, c] : p.lamp_costs)
-      detail::charge_misfit(h.map_costs.misfits, l, c, o.lamp_out_cost);
-    for (const StraySighting& b : p.strays)
-      if (b.reach <= o.stray_reach_max_m)
-        detail::charge_stray(h.map_costs.strays, b.at, std::max(o.stray_radius_m, b.reach),
-                             omni->options().pairs.spurious_cost, o.unmapped_lamp_cost);
+    // What the image said (births() weighs the newborn with it bounded alike).
+    charge_image(h, p.missed, p.strays, p.lamp_costs);
     ++counts.born;
     return h;
   }
