@@ -145,21 +145,26 @@ struct HypothesisSet::Impl {
   }
 
   // Charges what an omni image said of a hypothesis to its ledgers (map_evidence.hpp): the lamps
-  // it missed, its blobs no lamp explains placed well enough for a spot, what each lamp's
-  // directions cost. Returns what the ledgers charged less what the image's score counted for
-  // them in full.
-  double charge_image(Hypothesis& h, const std::vector<const graph::Lamp*>& missed,
+  // it missed, its `unexplained` blobs no lamp explains (those placed well enough to a spot, the
+  // rest to the far account), what each lamp's directions cost. Returns what the ledgers charged
+  // less what the image's score counted for them in full.
+  double charge_image(Hypothesis& h, const std::vector<const graph::Lamp*>& missed, int unexplained,
                       const std::vector<StraySighting>& strays,
                       const std::vector<std::pair<const graph::Lamp*, double>>& lamp_costs) const {
     const double each = omni->options().pairs.miss_cost;
     const double stray = omni->options().pairs.spurious_cost;
     double delta = detail::charge_absences(h.map_costs.lamps, missed, each, o.lamp_out_cost) -
                    each * static_cast<double>(missed.size());
+    int placed = 0;
     for (const StraySighting& b : strays)
-      if (b.reach <= o.stray_reach_max_m)
+      if (b.reach <= o.stray_reach_max_m) {
+        ++placed;
         delta += detail::charge_stray(h.map_costs.strays, b.at, std::max(o.stray_radius_m, b.reach),
                                       stray, o.unmapped_lamp_cost) -
                  stray;
+      }
+    const double far = stray * std::max(0, unexplained - placed);
+    delta += detail::charge_account(h.map_costs.far_strays, far, o.far_stray_cost_max) - far;
     for (const auto& [l, c] : lamp_costs)
       delta += detail::charge_misfit(h.map_costs.misfits, l, c, o.lamp_out_cost) - c;
     return delta;
@@ -187,13 +192,13 @@ struct HypothesisSet::Impl {
                                       std::pow(o.omni_bump_sigma_deg * kDeg, 2));
       const int seen = static_cast<int>(r->matches.size()) + r->unexplained;
       // A misfit better than expected says nothing (map_evidence.hpp, charge_misfit).
-      return {r->score + charge_image(h, r->missed, r->strays, r->lamp_costs) +
+      return {r->score + charge_image(h, r->missed, r->unexplained, r->strays, r->lamp_costs) +
                   std::max(0.0, update(h, r->pose, R)),
               contradicts(r->expected, r->missing, seen, r->unexplained)};
     }
     // Nothing to refine on: the prediction scored as it stands, with its own uncertainty.
     const GlobalLocalizer::PoseScore sc = omni->score(h.pose, ps, ys, d);
-    return {sc.cost + charge_image(h, sc.missed, sc.strays, sc.lamp_costs),
+    return {sc.cost + charge_image(h, sc.missed, sc.unexplained, sc.strays, sc.lamp_costs),
             contradicts(sc.expected, sc.missing, sc.matched + sc.unexplained, sc.unexplained)};
   }
 
@@ -347,7 +352,7 @@ struct HypothesisSet::Impl {
     h.log_weight = log_weight;
     h.node = p.node;
     // What the image said (births() weighs the newborn with it bounded alike).
-    charge_image(h, p.missed, p.strays, p.lamp_costs);
+    charge_image(h, p.missed, p.unexplained, p.strays, p.lamp_costs);
     ++counts.born;
     return h;
   }
@@ -451,12 +456,15 @@ struct HypothesisSet::Impl {
     std::size_t n = 0;
     while (n < r.hypotheses.size() && r.hypotheses[n].score <= best_score + margin) ++n;
     // Weighed with each lamp the image missed costing at most lamp_out_cost, each blob no lamp
-    // explains at most unmapped_lamp_cost.
+    // explains at most unmapped_lamp_cost, the far ones at most far_stray_cost_max together.
     const auto capped = [&](const PoseHypothesis& h) {
       const auto& q = omni->options().pairs;
+      const int placed = placed_strays(h.strays);
+      const double far = q.spurious_cost * std::max(0, h.unexplained - placed);
       return detail::with_each_bounded(
-          detail::with_each_bounded(h.score, h.missing, q.miss_cost, o.lamp_out_cost),
-          placed_strays(h.strays), q.spurious_cost, o.unmapped_lamp_cost);
+                 detail::with_each_bounded(h.score, h.missing, q.miss_cost, o.lamp_out_cost),
+                 placed, q.spurious_cost, o.unmapped_lamp_cost) -
+             far + std::min(far, o.far_stray_cost_max);
     };
     double capped_best = capped(r.hypotheses.front());
     for (std::size_t k = 1; k < n; ++k)

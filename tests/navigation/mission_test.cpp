@@ -77,7 +77,11 @@ void replay_gives_the_live_estimates(const Driven& d, const Scorer& live) {
   EXPECT_LE(m.position_error_m.mean, 0.05);
   EXPECT_EQ(m.kidnaps, 1);
   EXPECT_EQ(m.recoveries, 1);
-  EXPECT_LE(m.relocalization_latency_s.max, 5.0);
+  // 3.3 s until 11-28, when the omni images' far blobs no lamp explains were charged anew in
+  // every image, and the far view told the twin corridor apart within a second. Such blobs now
+  // share one bounded account (far_stray_cost_max): the robot drives on along the corridor to
+  // where the twins' near views differ, and relocalizes 11.3 s after the kidnap.
+  EXPECT_LE(m.relocalization_latency_s.max, 15.0);
   EXPECT_GT(m.lost_s + m.ambiguous_s, 0.0);
   EXPECT_EQ(m.wrong_fixes, 0);
   EXPECT_GT(m.lamps_labelled, m.lamps_seen / 2);
