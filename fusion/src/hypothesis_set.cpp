@@ -137,11 +137,16 @@ struct HypothesisSet::Impl {
     return std::sqrt(std::max(P(0, 0), P(1, 1)));
   }
 
-  // The omni strays placed well enough to be charged to a spot.
+  // Whether an omni stray places its lamp well enough to be charged to a spot.
+  bool placed(const StraySighting& b) const { return b.reach <= o.stray_reach_max_m; }
   int placed_strays(const std::vector<StraySighting>& strays) const {
-    return static_cast<int>(
-        std::count_if(strays.begin(), strays.end(),
-                      [&](const StraySighting& b) { return b.reach <= o.stray_reach_max_m; }));
+    return static_cast<int>(std::count_if(strays.begin(), strays.end(),
+                                          [&](const StraySighting& b) { return placed(b); }));
+  }
+  // What an image's `unexplained` blobs that place no lamp well enough for a spot cost in full
+  // (the far account's charge before its bound).
+  double far_cost(int unexplained, const std::vector<StraySighting>& strays) const {
+    return omni->options().pairs.spurious_cost * std::max(0, unexplained - placed_strays(strays));
   }
 
   // Charges what an omni image said of a hypothesis to its ledgers (map_evidence.hpp): the lamps
@@ -155,15 +160,12 @@ struct HypothesisSet::Impl {
     const double stray = omni->options().pairs.spurious_cost;
     double delta = detail::charge_absences(h.map_costs.lamps, missed, each, o.lamp_out_cost) -
                    each * static_cast<double>(missed.size());
-    int placed = 0;
     for (const StraySighting& b : strays)
-      if (b.reach <= o.stray_reach_max_m) {
-        ++placed;
+      if (placed(b))
         delta += detail::charge_stray(h.map_costs.strays, b.at, std::max(o.stray_radius_m, b.reach),
                                       stray, o.unmapped_lamp_cost) -
                  stray;
-      }
-    const double far = stray * std::max(0, unexplained - placed);
+    const double far = far_cost(unexplained, strays);
     delta += detail::charge_account(h.map_costs.far_strays, far, o.far_stray_cost_max) - far;
     for (const auto& [l, c] : lamp_costs)
       delta += detail::charge_misfit(h.map_costs.misfits, l, c, o.lamp_out_cost) - c;
@@ -459,11 +461,10 @@ struct HypothesisSet::Impl {
     // explains at most unmapped_lamp_cost, the far ones at most far_stray_cost_max together.
     const auto capped = [&](const PoseHypothesis& h) {
       const auto& q = omni->options().pairs;
-      const int placed = placed_strays(h.strays);
-      const double far = q.spurious_cost * std::max(0, h.unexplained - placed);
+      const double far = far_cost(h.unexplained, h.strays);
       return detail::with_each_bounded(
                  detail::with_each_bounded(h.score, h.missing, q.miss_cost, o.lamp_out_cost),
-                 placed, q.spurious_cost, o.unmapped_lamp_cost) -
+                 placed_strays(h.strays), q.spurious_cost, o.unmapped_lamp_cost) -
              far + std::min(far, o.far_stray_cost_max);
     };
     double capped_best = capped(r.hypotheses.front());
