@@ -1,4 +1,5 @@
 // lampnav map build LOG.mcap [--robot R.json] -o M.geojson [--names NAMES.json]
+//                   [--distance FROM,TO,METRES ...]
 // lampnav map survey M LOG.mcap [--robot R.json] [--json] [--update OUT.geojson]
 
 #include <CLI/CLI.hpp>
@@ -7,6 +8,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <sstream>
 
 #include <iomanip>
 #include <nlohmann/json.hpp>
@@ -23,6 +25,7 @@ namespace {
 
 struct BuildArgs {
   std::string log, robot, out, names, initial_pose;
+  std::vector<std::string> distances;
   io::BagTopics topics;
   double corridor_width = 2.0;
   bool quiet = false;
@@ -45,17 +48,44 @@ std::vector<mapping::PlaceName> read_names(const std::string& path) {
   return names;
 }
 
+// --distance FROM,TO,METRES: two lamp ids of the map and their distance measured in the building.
+mapping::KnownDistance parse_distance_option(const std::string& text) {
+  const std::string flag = "--distance " + text;
+  std::vector<std::string> parts;
+  std::stringstream in(text);
+  std::string part;
+  while (std::getline(in, part, ',')) parts.push_back(part);
+  if (parts.size() != 3 || parts[0].empty() || parts[1].empty())
+    throw InputError({"", flag, ""},
+                     "expected FROM,TO,METRES: two lamp ids of the map and the distance measured "
+                     "between them, e.g. C1-L2,C4-L7,24.315");
+  mapping::KnownDistance d;
+  d.from = parts[0];
+  d.to = parts[1];
+  d.given_as = flag;
+  try {
+    std::size_t used = 0;
+    d.metres = std::stod(parts[2], &used);
+    if (used != parts[2].size()) throw std::invalid_argument(parts[2]);
+  } catch (const std::exception&) {
+    throw InputError({"", flag, ""}, "'" + parts[2] + "' is not a number of metres");
+  }
+  return d;
+}
+
 int run_build(const BuildArgs& a) {
   const auto t0 = std::chrono::steady_clock::now();
   const std::vector<mapping::PlaceName> names =
       a.names.empty() ? std::vector<mapping::PlaceName>{} : read_names(a.names);
+  mapping::MapBuildOptions o;
+  o.topology.corridor_width_m = a.corridor_width;
+  if (!a.initial_pose.empty()) o.start = parse_pose_option(a.initial_pose, "--initial-pose");
+  for (const auto& d : a.distances) o.distances.push_back(parse_distance_option(d));
+  o.validate();  // before the log is read and mapped: a mistyped flag is told at once
   RobotDescription robot;
   const io::MissionLog log = read_log_for_robot(a.log, a.robot, a.topics, robot);
   const double read_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  mapping::MapBuildOptions o;
-  o.topology.corridor_width_m = a.corridor_width;
-  if (!a.initial_pose.empty()) o.start = parse_pose_option(a.initial_pose, "--initial-pose");
   ProgressBar bar(a.quiet);
   const mapping::MapBuildResult r = mapping::build_map(
       log, a.log, robot, o, names, [&bar](double f) { bar.update(f, "mapping"); });
@@ -202,6 +232,10 @@ void add_map_build_command(CLI::App& map, Job& run) {
   build->add_option("--initial-pose", args->initial_pose,
                     "X,Y,YAW: where the drive started, in the frame the map should have (m, m, "
                     "rad); default: the start is the origin, facing x");
+  build->add_option("--distance", args->distances,
+                    "FROM,TO,METRES: two lamps of the map (ids as `map render --lamp-ids` shows "
+                    "them) and their distance measured in the building; scales the map to it "
+                    "(repeatable)");
   build->add_flag("--quiet", args->quiet, "No progress bar");
   add_bag_topic_options(*build, args->topics);
   build->callback([args, &run] { run = [args] { return run_build(*args); }; });

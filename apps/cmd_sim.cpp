@@ -28,6 +28,7 @@ struct SimArgs {
   double bump_deg = 0.5;
   std::optional<double> ceiling_delay, omni_delay;
   std::string image_format;
+  std::vector<double> wheel_scale;  // left, right
 };
 
 int run_sim(const SimArgs& a) {
@@ -69,6 +70,14 @@ int run_sim(const SimArgs& a) {
             [](const auto& x, const auto& y) { return x.at_s < y.at_s; });
   for (const auto& id : a.failed_lamps) s.failed_lamps.insert(id);
   s.bump_sigma_rad = a.no_bumps ? 0.0 : a.bump_deg * M_PI / 180.0;
+  if (!a.wheel_scale.empty()) {
+    if (a.wheel_scale.size() != 2)
+      throw InputError({"", "--wheel-scale", ""}, "expected LEFT,RIGHT (two fractions), found " +
+                                                      std::to_string(a.wheel_scale.size()) +
+                                                      " numbers");
+    s.odometry.left_scale = a.wheel_scale[0];
+    s.odometry.right_scale = a.wheel_scale[1];
+  }
   if (a.ceiling_delay) s.ceiling_delay_s = *a.ceiling_delay;
   if (a.omni_delay) s.omni_delay_s = *a.omni_delay;
   if (!a.image_format.empty())
@@ -117,6 +126,11 @@ void add_sim_command(CLI::App& app, Job& run) {
       ->capture_default_str()
       ->check(CLI::Range(0.0, 10.0));
   cmd->add_flag("--no-bumps", a->no_bumps, "Turn floor bumps off");
+  cmd->add_option("--wheel-scale", a->wheel_scale,
+                  "LEFT,RIGHT: how much longer than the truth each wheel reads its travel "
+                  "(fractions; default 0.004,-0.003)")
+      ->delimiter(',')
+      ->check(CLI::Range(-0.2, 0.2));
   cmd->add_option("--ceiling-delay", a->ceiling_delay,
                   "Ceiling camera capture-to-availability delay (s, default 1)")
       ->check(CLI::Range(0.0, 10.0));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/core/parallel.hpp"
@@ -18,6 +19,22 @@ void MapBuildOptions::validate() const {
   detector.validate();
   if (probe_frames < 10)
     throw InputError({"map build options", "", "probe_frames"}, "must be at least 10");
+  if (!(max_scale_change > 0 && max_scale_change < 0.5))
+    throw InputError({"map build options", "", "max_scale_change"},
+                     "must be above 0 and below 0.5");
+  if (!(tape_sigma_m >= 0 && tape_sigma_m < 1))
+    throw InputError({"map build options", "", "tape_sigma_m"}, "must be from 0 to 1 m");
+  if (!(distance_tolerance_m >= 0 && distance_tolerance_m < 10))
+    throw InputError({"map build options", "", "distance_tolerance_m"}, "must be from 0 to 10 m");
+  for (std::size_t k = 0; k < distances.size(); ++k) {
+    const KnownDistance& d = distances[k];
+    const ErrorContext where{
+        "", d.given_as.empty() ? "distances[" + std::to_string(k) + "]" : d.given_as, ""};
+    if (d.from.empty() || d.to.empty()) throw InputError(where, "names no lamp");
+    if (d.from == d.to) throw InputError(where, "names one lamp twice");
+    if (!(std::isfinite(d.metres) && d.metres > 0))
+      throw InputError(where, "the distance must be a number of metres above 0");
+  }
 }
 
 namespace {
@@ -34,6 +51,95 @@ vision::LampShapePrior probe_prior() {
   p.nominal_distance = 1.0;
   p.max_distance = 30.0;
   return p;
+}
+
+std::string metres(double m, int decimals = 3) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.*f m", decimals, m);
+  return buf;
+}
+
+std::string percent(double f, int decimals = 3) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.*f %%", decimals, 100 * f);
+  return buf;
+}
+
+// The scale that fits the measured distances best (least squares on the map's horizontal
+// distances between the named lamps), after the checks of MapBuildOptions::distances.
+double scale_for_distances(const graph::TopologicalMap& map, const MapBuildOptions& o,
+                           const std::string& source, std::vector<std::string>& notes) {
+  struct Pair {
+    ErrorContext where;
+    double map_m, measured_m;
+  };
+  std::vector<Pair> pairs;
+  for (std::size_t k = 0; k < o.distances.size(); ++k) {
+    const KnownDistance& d = o.distances[k];
+    const ErrorContext where{
+        "", d.given_as.empty() ? "distances[" + std::to_string(k) + "]" : d.given_as, ""};
+    const graph::Lamp* lamps[2] = {map.find_lamp(LampId(d.from)), map.find_lamp(LampId(d.to))};
+    for (int e = 0; e < 2; ++e)
+      if (!lamps[e])
+        throw InputError(where, "no lamp \"" + (e ? d.to : d.from) + "\" in the map built from " +
+                                    source +
+                                    " (its lamp ids: `lampnav map render MAP --lamp-ids` of the "
+                                    "map built without --distance)");
+    const double m = (lamps[0]->xyz.head<2>() - lamps[1]->xyz.head<2>()).norm();
+    if (m < 1e-6) throw InputError(where, "the two lamps are at one place in the map");
+    pairs.push_back({where, m, d.metres});
+  }
+  double num = 0, den = 0, measured = 0;
+  for (const Pair& p : pairs) {
+    num += p.measured_m * p.map_m;
+    den += p.map_m * p.map_m;
+    measured += p.measured_m;
+  }
+  const double s = num / den;
+  for (const Pair& p : pairs) {
+    const double change = p.map_m / p.measured_m - 1;
+    if (std::abs(p.measured_m / p.map_m - 1) > o.max_scale_change)
+      throw InputError(p.where, "the map has these lamps " + metres(p.map_m) + " apart, " +
+                                    percent(std::abs(change), 1) +
+                                    (change > 0 ? " more" : " less") +
+                                    " than measured; wheels are calibrated better than " +
+                                    percent(o.max_scale_change, 1) +
+                                    ": are these the lamps measured, and is the distance right?");
+  }
+  for (const Pair& p : pairs) {
+    const double off = s * p.map_m - p.measured_m;
+    if (pairs.size() > 1 && std::abs(off) > o.distance_tolerance_m + 3 * o.tape_sigma_m)
+      throw InputError(p.where,
+                       "disagrees with the other measured distances: scaled to fit "
+                       "them all, the map has these lamps " +
+                           metres(s * p.map_m) + " apart, " + metres(std::abs(off)) +
+                           (off > 0 ? " more" : " less") + " than measured");
+  }
+  // Uncertainty of the scale from the tape alone: sigma / sqrt(sum of squared lengths).
+  const double sigma = o.tape_sigma_m / std::sqrt(den);
+  notes.push_back("scaled by " + std::to_string(pairs.size()) + " measured distance" +
+                  (pairs.size() > 1 ? "s" : "") + " (" + metres(measured, 2) + " in all): the " +
+                  "wheels had made the map " + percent(std::abs(1 / s - 1)) +
+                  (s < 1 ? " larger" : " smaller") + " than the building (the tape's " +
+                  metres(o.tape_sigma_m) + " leaves " + percent(sigma) + " of scale)");
+  return s;
+}
+
+// The drive and its lamps scaled by `s` about `about` (the start), heights about the ceiling
+// camera's: every lamp then projects into every keyframe's camera as before (up to the camera's
+// offset from the robot's centre, which does not scale: 0.1 mm for 0.05 % at 20 cm), and only the
+// wheels' travel reads `s` times longer.
+void scale_drive(MappingResult& m, double s, const Eigen::Vector2d& about, double camera_z) {
+  for (auto& l : m.lamps) {
+    l.xyz.head<2>() = about + s * (l.xyz.head<2>() - about);
+    l.xyz.z() = camera_z + s * (l.xyz.z() - camera_z);
+    l.length *= s;
+    l.width *= s;
+  }
+  for (auto& k : m.keyframes) {
+    k.pose = Pose2(about + s * (k.pose.translation() - about), k.pose.yaw());
+    k.travel_m *= s;
+  }
 }
 
 }  // namespace
@@ -175,6 +281,17 @@ MapBuildResult build_map(const io::MissionLog& log, const std::string& source,
                     ": the drive has no straight stretch long enough to make a "
                     "corridor; " +
                     std::to_string(out.mapped.lamps.size()) + " lamps were mapped but no places");
+  if (!o.distances.empty()) {
+    // The places are found again on the scaled lamps (the ids the distances named stay: a
+    // scale of a fraction of a percent moves no lamp from its place or order).
+    std::vector<std::string> scale_notes;
+    out.scale = scale_for_distances(out.map, o, source, scale_notes);
+    const Eigen::Vector2d about = o.start ? o.start->translation() : Eigen::Vector2d::Zero();
+    scale_drive(out.mapped, out.scale, about, robot.find_camera("ceiling_camera")->mount.xyz.z());
+    out.travel_m *= out.scale;
+    out.map = build_topology(out.mapped, o.topology, names, &out.topology);
+    out.topology.notes.insert(out.topology.notes.end(), scale_notes.begin(), scale_notes.end());
+  }
   out.notes = out.topology.notes;
   if (out.mapped.revisits == 0)
     out.notes.push_back(

@@ -22,12 +22,13 @@ namespace fs = std::filesystem;
 struct Recorded {
   fs::path dir = fs::temp_directory_path() / ("lampnav_map_build_" + std::to_string(::getpid()));
   std::string log = (dir / "drive.mcap").string();
-  // The drive E1 -> K2 on `map` (the office floor's file unless given).
-  explicit Recorded(const std::string& map = test::source_path("maps/office_floor.geojson")) {
+  // The drive E1 -> K2 on `map` (the office floor's file unless given), `sim` flags added.
+  explicit Recorded(const std::string& map = test::source_path("maps/office_floor.geojson"),
+                    const std::string& flags = "") {
     fs::create_directories(dir);
-    const auto r =
-        test::run_lampnav("sim --route 'E1 -> K2' --map '" + map + "' --robot " +
-                          test::quoted_source("maps/robots/pioneer.json") + " -o '" + log + "'");
+    const auto r = test::run_lampnav("sim --route 'E1 -> K2' --map '" + map + "' --robot " +
+                                     test::quoted_source("maps/robots/pioneer.json") + " -o '" +
+                                     log + "' " + flags);
     EXPECT_EQ(r.status, 0) << r.err;
   }
   ~Recorded() { fs::remove_all(dir); }
@@ -153,6 +154,102 @@ TEST(MapBuild, ADriveBecomesAValidMapWithTheLampsWhereTheyAre) {
   }
   EXPECT_EQ(test::run_lampnav("map check '" + (rec.dir / "fixed.geojson").string() + "'").status,
             0);
+}
+
+// Wheels that read 1 % long make a map 1 % too large, and no camera looking up can tell (a
+// smaller building with a lower ceiling looks the same): the far end of E1 -> K2 is 20 cm off.
+// One distance measured between two lamps gives the map its scale back; distances that cannot
+// be right are refused, and no map is written.
+TEST(MapBuild, AMeasuredDistanceGivesTheMapItsScale) {
+  const Recorded rec(test::source_path("maps/office_floor.geojson"), "--wheel-scale 0.01,0.01");
+  const graph::TopologicalMap truth =
+      graph::read_map(test::source_path("maps/office_floor.geojson")).map;
+  const Pose2 start = io::read_mission_log(rec.log).truth.front().value.pose;
+  const std::string out = (rec.dir / "built.geojson").string();
+  // The built lamps against the true ones (the nearest within a metre, placed by the start),
+  // after the best rigid alignment; and the built lamps on the true E1 and K2 lamps.
+  struct Errors {
+    double rms = 0, worst = 0;
+    std::string first, last;
+  };
+  auto errors = [&](const std::string& path) {
+    const graph::TopologicalMap built = graph::read_map(path).map;
+    Errors e;
+    std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> pairs;
+    for (const auto& n : built.nodes()) {
+      for (const auto& l : n.lamps) {
+        const auto near = truth.lamps_within(start.transform_from(l.xyz.head<2>()), 1.0);
+        if (near.empty()) {
+          ADD_FAILURE() << l.id.value << ": no true lamp within a metre";
+          continue;
+        }
+        if (near.front()->id.value == "E1-L1") e.first = l.id.value;
+        if (near.front()->id.value == "K2-L1") e.last = l.id.value;
+        pairs.emplace_back(l.xyz.head<2>(), near.front()->xyz.head<2>());
+      }
+    }
+    const Pose2 fit = mapping::fit_rigid(pairs);
+    double sum = 0;
+    for (const auto& [b, t] : pairs) {
+      const double err = (fit.transform_from(b) - t).norm();
+      e.worst = std::max(e.worst, err);
+      sum += err * err;
+    }
+    e.rms = std::sqrt(sum / std::max<std::size_t>(1, pairs.size()));
+    return e;
+  };
+  const std::string build = "map build '" + rec.log + "' -o '" + out + "' --quiet";
+  ASSERT_EQ(test::run_lampnav(build).status, 0);
+  const Errors before = errors(out);
+  std::cout << "wheels 1 % long: error rms " << before.rms * 100 << " cm, max "
+            << before.worst * 100 << " cm\n";
+  EXPECT_GT(before.worst, 0.1);
+  ASSERT_FALSE(before.first.empty());
+  ASSERT_FALSE(before.last.empty());
+  // Measured with a laser meter, 3 mm long.
+  const double true_m =
+      (truth.find_lamp(LampId("E1-L1"))->xyz - truth.find_lamp(LampId("K2-L1"))->xyz).norm();
+  char metres[32];
+  std::snprintf(metres, sizeof metres, "%.3f", true_m + 0.003);
+  const std::string pair = before.first + "," + before.last + ",";
+  fs::remove(out);
+  const auto r = test::run_lampnav(build + " --distance " + pair + metres);
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("scaled by 1 measured distance"));
+  EXPECT_THAT(r.err, HasSubstr("larger than the building"));
+  const Errors after = errors(out);
+  std::cout << "with the distance: error rms " << after.rms * 100 << " cm, max "
+            << after.worst * 100 << " cm\n";
+  EXPECT_LE(after.rms, 0.02);
+  EXPECT_LE(after.worst, 0.05);
+  EXPECT_EQ(test::run_lampnav("map check '" + out + "'").status, 0);
+
+  // Refused, naming the flag, and no map written.
+  fs::remove(out);
+  const std::pair<std::string, std::string> refused[] = {
+      {before.first + ",NOPE,10", "no lamp \"NOPE\""},
+      {pair + "48", "are these the lamps measured"},
+      {pair + "4x", "not a number of metres"},
+      {before.first + ",10", "expected FROM,TO,METRES"},
+      {pair + metres + " --distance " + before.first + "," + before.first + ",5",
+       "names one lamp twice"},
+  };
+  for (const auto& [flag, says] : refused) {
+    const auto bad = test::run_lampnav(build + " --distance " + flag);
+    EXPECT_EQ(bad.status, 2) << flag;
+    EXPECT_THAT(bad.err, HasSubstr("--distance")) << flag;
+    EXPECT_THAT(bad.err, HasSubstr(says)) << flag;
+    EXPECT_FALSE(fs::exists(out)) << flag;
+  }
+  // Two distances between the same lamps 0.7 % apart (30 cm): each within what the wheels allow,
+  // but not both right.
+  std::snprintf(metres, sizeof metres, "%.3f", 0.993 * true_m);
+  const auto two =
+      test::run_lampnav(build + " --distance " + pair + std::to_string(true_m) + " --distance " +
+                        before.last + "," + before.first + "," + metres);
+  EXPECT_EQ(two.status, 2);
+  EXPECT_THAT(two.err, HasSubstr("disagrees with the other measured distances"));
+  EXPECT_FALSE(fs::exists(out));
 }
 
 // A building whose lamps hang 8 m up (a hall, a warehouse): map build does not assume the

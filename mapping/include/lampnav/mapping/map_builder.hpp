@@ -21,6 +21,16 @@ struct MissionLog;
 
 namespace lampnav::mapping {
 
+// A distance measured in the building between two lamps of the map: a laser meter or a tape on
+// the floor below their centres, or the lighting plan. It is what gives the map its true scale:
+// the ceiling camera sees a building and a smaller one with a lower ceiling alike, so without a
+// measured distance the map's scale is the wheels' calibration (docs/mapping.md, "Scale").
+struct KnownDistance {
+  std::string from, to;  // lamp ids in the map built without it (`map render --lamp-ids`)
+  double metres = 0;     // horizontal, centre to centre
+  std::string given_as;  // how the user gave it (the CLI's "--distance ..."), for messages
+};
+
 struct MapBuildOptions {
   LampMapperOptions mapper;
   TopologyOptions topology;
@@ -29,7 +39,16 @@ struct MapBuildOptions {
   // Where the drive started, in the frame the map should have (an existing map's, a floor plan's);
   // without it the map's frame is the start itself (x forward, y left).
   std::optional<Pose2> start;
-  void validate() const;  // throws InputError naming the field
+  // Distances measured between lamps: the map is scaled to fit them (least squares), about the
+  // drive's start; heights above the ceiling camera scale alike. Refused (InputError) when a lamp
+  // is not in the map, when they ask for a scale further than `max_scale_change` from the wheels'
+  // (not the lamps measured, or the tape misread), or when they disagree with each other by more
+  // than `distance_tolerance_m` plus 3 sigma of the tape.
+  std::vector<KnownDistance> distances;
+  double max_scale_change = 0.02;     // wheels are calibrated to better than 2 %
+  double tape_sigma_m = 0.003;        // a measured distance's error (1 sigma)
+  double distance_tolerance_m = 0.1;  // what the map's own lamps may be off between two of them
+  void validate() const;              // throws InputError naming the field
 };
 
 // The lamps of a recorded drive (the first half of a map build; a survey's whole input).
@@ -46,6 +65,7 @@ struct DriveLamps {
 struct MapBuildResult : DriveLamps {
   graph::TopologicalMap map;
   TopologyReport topology;
+  double scale = 1;  // applied to fit the measured distances (1 without them)
 };
 
 // The lamp SLAM over a recorded drive. Throws as build_map does.
