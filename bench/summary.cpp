@@ -360,6 +360,16 @@ int main(int argc, char** argv) {
               std::nullopt, "cm");
     add_value(drive + ", lamp height max", counter(bench, "height_max_cm", 1), "", std::nullopt,
               3.0, std::nullopt, "cm");
+    // The scale, which no camera looking up can see, taken out: what the mapping itself leaves.
+    add_value(drive + ", lamp position RMS, scale taken out", counter(bench, "rms_scaled_cm", 1),
+              "", std::nullopt, std::nullopt, std::nullopt, "cm");
+    add_value(drive + ", lamp position max, scale taken out", counter(bench, "max_scaled_cm", 1),
+              "", std::nullopt, std::nullopt, std::nullopt, "cm");
+    // Built again with two distances measured down corridors (map build --distance).
+    add_value(drive + ", with 2 distances measured, lamp position RMS",
+              counter(bench, "measured_rms_cm", 1), "", std::nullopt, 2.0, std::nullopt, "cm");
+    add_value(drive + ", with 2 distances measured, lamp position max",
+              counter(bench, "measured_max_cm", 1), "", std::nullopt, 5.0, std::nullopt, "cm");
   }
   for (const auto& [arg, format] : {std::pair{"0/0", "PNG"},
                                     {"90/0", "JPEG 90"},
