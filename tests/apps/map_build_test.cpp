@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 
@@ -39,22 +40,24 @@ struct Recorded {
 // rigid alignment (the map's frame is the drive's start). A lamp with no true lamp there, or a
 // true lamp matched twice, fails the test.
 struct LampErrors {
-  std::set<std::string> matched;  // true lamp ids
+  std::set<std::string> matched;             // true lamp ids
+  std::map<std::string, std::string> built;  // the built lamp's id on each true one
   double rms = 0, worst = 0;
 };
 
 LampErrors lamp_errors(const graph::TopologicalMap& built, const graph::TopologicalMap& truth,
-                       const Pose2& start) {
+                       const Pose2& start, double within_m = 0.3) {
   LampErrors e;
   std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> pairs;
   for (const auto& n : built.nodes()) {
     for (const auto& l : n.lamps) {
       const Eigen::Vector2d at = start.transform_from(l.xyz.head<2>());
-      const auto near = truth.lamps_within(at, 0.3);
+      const auto near = truth.lamps_within(at, within_m);
       if (near.empty()) {
         ADD_FAILURE() << l.id.value << " at " << at.transpose() << ": no true lamp there";
         continue;
       }
+      e.built[near.front()->id.value] = l.id.value;
       if (!e.matched.insert(near.front()->id.value).second)
         ADD_FAILURE() << "twice: " << near.front()->id.value;
       pairs.emplace_back(l.xyz.head<2>(), near.front()->xyz.head<2>());
@@ -166,58 +169,31 @@ TEST(MapBuild, AMeasuredDistanceGivesTheMapItsScale) {
       graph::read_map(test::source_path("maps/office_floor.geojson")).map;
   const Pose2 start = io::read_mission_log(rec.log).truth.front().value.pose;
   const std::string out = (rec.dir / "built.geojson").string();
-  // The built lamps against the true ones (the nearest within a metre, placed by the start),
-  // after the best rigid alignment; and the built lamps on the true E1 and K2 lamps.
-  struct Errors {
-    double rms = 0, worst = 0;
-    std::string first, last;
-  };
+  // The built lamps against the true ones (the nearest within a metre, placed by the start).
   auto errors = [&](const std::string& path) {
-    const graph::TopologicalMap built = graph::read_map(path).map;
-    Errors e;
-    std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> pairs;
-    for (const auto& n : built.nodes()) {
-      for (const auto& l : n.lamps) {
-        const auto near = truth.lamps_within(start.transform_from(l.xyz.head<2>()), 1.0);
-        if (near.empty()) {
-          ADD_FAILURE() << l.id.value << ": no true lamp within a metre";
-          continue;
-        }
-        if (near.front()->id.value == "E1-L1") e.first = l.id.value;
-        if (near.front()->id.value == "K2-L1") e.last = l.id.value;
-        pairs.emplace_back(l.xyz.head<2>(), near.front()->xyz.head<2>());
-      }
-    }
-    const Pose2 fit = mapping::fit_rigid(pairs);
-    double sum = 0;
-    for (const auto& [b, t] : pairs) {
-      const double err = (fit.transform_from(b) - t).norm();
-      e.worst = std::max(e.worst, err);
-      sum += err * err;
-    }
-    e.rms = std::sqrt(sum / std::max<std::size_t>(1, pairs.size()));
-    return e;
+    return lamp_errors(graph::read_map(path).map, truth, start, 1.0);
   };
   const std::string build = "map build '" + rec.log + "' -o '" + out + "' --quiet";
   ASSERT_EQ(test::run_lampnav(build).status, 0);
-  const Errors before = errors(out);
+  const LampErrors before = errors(out);
   std::cout << "wheels 1 % long: error rms " << before.rms * 100 << " cm, max "
             << before.worst * 100 << " cm\n";
   EXPECT_GT(before.worst, 0.1);
-  ASSERT_FALSE(before.first.empty());
-  ASSERT_FALSE(before.last.empty());
+  ASSERT_EQ(before.built.count("E1-L1"), 1u);
+  ASSERT_EQ(before.built.count("K2-L1"), 1u);
+  const std::string first = before.built.at("E1-L1"), last = before.built.at("K2-L1");
   // Measured with a laser meter, 3 mm long.
   const double true_m =
       (truth.find_lamp(LampId("E1-L1"))->xyz - truth.find_lamp(LampId("K2-L1"))->xyz).norm();
   char metres[32];
   std::snprintf(metres, sizeof metres, "%.3f", true_m + 0.003);
-  const std::string pair = before.first + "," + before.last + ",";
+  const std::string pair = first + "," + last + ",";
   fs::remove(out);
   const auto r = test::run_lampnav(build + " --distance " + pair + metres);
   ASSERT_EQ(r.status, 0) << r.err;
   EXPECT_THAT(r.err, HasSubstr("scaled by 1 measured distance"));
   EXPECT_THAT(r.err, HasSubstr("larger than the building"));
-  const Errors after = errors(out);
+  const LampErrors after = errors(out);
   std::cout << "with the distance: error rms " << after.rms * 100 << " cm, max "
             << after.worst * 100 << " cm\n";
   EXPECT_LE(after.rms, 0.02);
@@ -227,12 +203,11 @@ TEST(MapBuild, AMeasuredDistanceGivesTheMapItsScale) {
   // Refused, naming the flag, and no map written.
   fs::remove(out);
   const std::pair<std::string, std::string> refused[] = {
-      {before.first + ",NOPE,10", "no lamp \"NOPE\""},
+      {first + ",NOPE,10", "no lamp \"NOPE\""},
       {pair + "48", "are these the lamps measured"},
       {pair + "4x", "not a number of metres"},
-      {before.first + ",10", "expected FROM,TO,METRES"},
-      {pair + metres + " --distance " + before.first + "," + before.first + ",5",
-       "names one lamp twice"},
+      {first + ",10", "expected FROM,TO,METRES"},
+      {pair + metres + " --distance " + first + "," + first + ",5", "names one lamp twice"},
   };
   for (const auto& [flag, says] : refused) {
     const auto bad = test::run_lampnav(build + " --distance " + flag);
@@ -244,9 +219,8 @@ TEST(MapBuild, AMeasuredDistanceGivesTheMapItsScale) {
   // Two distances between the same lamps 0.7 % apart (30 cm): each within what the wheels allow,
   // but not both right.
   std::snprintf(metres, sizeof metres, "%.3f", 0.993 * true_m);
-  const auto two =
-      test::run_lampnav(build + " --distance " + pair + std::to_string(true_m) + " --distance " +
-                        before.last + "," + before.first + "," + metres);
+  const auto two = test::run_lampnav(build + " --distance " + pair + std::to_string(true_m) +
+                                     " --distance " + last + "," + first + "," + metres);
   EXPECT_EQ(two.status, 2);
   EXPECT_THAT(two.err, HasSubstr("disagrees with the other measured distances"));
   EXPECT_FALSE(fs::exists(out));
