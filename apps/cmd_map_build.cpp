@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <map>
@@ -148,15 +149,17 @@ int run_survey(const SurveyArgs& a) {
   }
   auto xyz = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
   if (a.json) {
-    nlohmann::json j = {{"map", a.map},
-                        {"log", a.log},
-                        {"judged", s.judged},
-                        {"ok", s.ok},
-                        {"failed", failed},
-                        {"moved", moved},
-                        {"new", added},
-                        {"alignment", {{"lamps", s.agreeing}, {"rms_m", s.alignment_rms_m}}},
-                        {"lamps", nlohmann::json::array()}};
+    nlohmann::json j = {
+        {"map", a.map},
+        {"log", a.log},
+        {"judged", s.judged},
+        {"ok", s.ok},
+        {"failed", failed},
+        {"moved", moved},
+        {"new", added},
+        {"alignment",
+         {{"lamps", s.agreeing}, {"rms_m", s.alignment_rms_m}, {"drive_scale", s.drive_scale}}},
+        {"lamps", nlohmann::json::array()}};
     for (const auto& f : s.findings) {
       nlohmann::json e = {{"status", mapping::to_string(f.status)},
                           {"id", f.lamp},
@@ -170,6 +173,13 @@ int run_survey(const SurveyArgs& a) {
     if (!a.update.empty()) j["updated_map"] = a.update;
     std::cout << j.dump(2) << "\n";
     return 0;
+  }
+  if (std::abs(s.drive_scale - 1) >= 5e-4) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf,
+                  "the drive's wheels read %.2f %% %s than the map: the drive was scaled to it",
+                  100 * std::abs(1 / s.drive_scale - 1), s.drive_scale < 1 ? "longer" : "shorter");
+    diagnostic("note", buf);
   }
   std::cout << "survey of " << a.map << " with " << a.log << ": " << s.judged
             << " lamps in clear view, " << s.ok << " where the map has them; " << failed

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "drive_scale.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/core/parallel.hpp"
 #include "lampnav/graph/geojson.hpp"
@@ -123,23 +124,6 @@ double scale_for_distances(const graph::TopologicalMap& map, const MapBuildOptio
                   (s < 1 ? " larger" : " smaller") + " than the building (the tape's " +
                   metres(o.tape_sigma_m) + " leaves " + percent(sigma) + " of scale)");
   return s;
-}
-
-// The drive and its lamps scaled by `s` about `about` (the start), heights about the ceiling
-// camera's: every lamp then projects into every keyframe's camera as before (up to the camera's
-// offset from the robot's centre, which does not scale: 0.1 mm for 0.05 % at 20 cm), and only the
-// wheels' travel reads `s` times longer.
-void scale_drive(MappingResult& m, double s, const Eigen::Vector2d& about, double camera_z) {
-  for (auto& l : m.lamps) {
-    l.xyz.head<2>() = about + s * (l.xyz.head<2>() - about);
-    l.xyz.z() = camera_z + s * (l.xyz.z() - camera_z);
-    l.length *= s;
-    l.width *= s;
-  }
-  for (auto& k : m.keyframes) {
-    k.pose = Pose2(about + s * (k.pose.translation() - about), k.pose.yaw());
-    k.travel_m *= s;
-  }
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <map>
 #include <optional>
 
+#include "drive_scale.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/ceiling_geometry.hpp"
 #include "lampnav/graph/route_commands.hpp"
@@ -24,6 +25,8 @@ void SurveyOptions::validate() const {
   check(match_m > moved_m, "match_m", "must be more than moved_m");
   check(min_views >= 1, "min_views", "must be at least 1");
   check(view_margin >= 0 && view_margin < 0.5, "view_margin", "must be 0 to 0.5");
+  check(max_scale_change >= 0 && max_scale_change < 0.5, "max_scale_change", "must be 0 to 0.5");
+  check(scale_extent_m >= 0, "scale_extent_m", "must not be negative");
 }
 
 const char* to_string(LampStatus s) {
@@ -89,9 +92,10 @@ std::string describe(const graph::TopologicalMap& map, const graph::Node& n, con
 
 }  // namespace
 
-SurveyResult survey(const graph::TopologicalMap& map, const MappingResult& drive,
+SurveyResult survey(const graph::TopologicalMap& map, const MappingResult& drive_as_mapped,
                     const RobotDescription& robot, const SurveyOptions& o) {
   o.validate();
+  MappingResult drive = drive_as_mapped;  // scaled to the map below
   const CameraDescription* cam = robot.find_camera("ceiling_camera");
   if (!cam) throw InputError({"robot.json", "", "cameras"}, "no camera named \"ceiling_camera\"");
   const auto& seen = drive.lamps;
@@ -189,22 +193,46 @@ SurveyResult survey(const graph::TopologicalMap& map, const MappingResult& drive
         "; give the start (--initial-pose X,Y,YAW) or drive on past a place "
         "that tells them apart");
   }
-  // Refine on the lamps that agree closely (moved lamps kept out).
+  // Refine on the lamps that agree closely (moved lamps kept out), and scale the drive to the map:
+  // wheels 1 % long put lamps 40 m away 40 cm off, so the lamps within the gate are taken again
+  // after each fit, until the gate holds them all and the last round keeps the close ones.
   SurveyResult out;
-  Pose2 T = best.front().T;
-  for (int round = 0; round < 2; ++round) {
+  Similarity fit{best.front().T, 1.0};
+  for (int round = 0; round < 5; ++round) {
     std::vector<std::pair<Vector2d, Vector2d>> pairs;
     for (const auto& l : seen) {
       const auto near =
-          map.lamps_within(T.transform_from(l.xyz.head<2>()), round ? 0.08 : inlier_m);
+          map.lamps_within(fit.transform_from(l.xyz.head<2>()), round == 4 ? 0.08 : inlier_m);
       if (!near.empty()) pairs.emplace_back(l.xyz.head<2>(), near.front()->xyz.head<2>());
     }
-    if (pairs.size() >= 3) T = fit_rigid(pairs);
+    if (pairs.size() >= 3) {
+      Vector2d middle = Vector2d::Zero();
+      for (const auto& p : pairs) middle += p.first;
+      middle /= static_cast<double>(pairs.size());
+      double spread = 0;
+      for (const auto& p : pairs) spread += (p.first - middle).squaredNorm();
+      const bool scale_seen = std::sqrt(spread / pairs.size()) >= o.scale_extent_m;
+      fit = scale_seen ? fit_similarity(pairs) : Similarity{fit_rigid(pairs), 1.0};
+    }
     double sum = 0;
-    for (const auto& [a, b] : pairs) sum += (T.transform_from(a) - b).squaredNorm();
+    for (const auto& [a, b] : pairs) sum += (fit.transform_from(a) - b).squaredNorm();
     out.alignment_rms_m = pairs.empty() ? 0 : std::sqrt(sum / pairs.size());
     out.agreeing = static_cast<int>(pairs.size());
   }
+  if (std::abs(fit.scale - 1) > o.max_scale_change) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "the drive's lamps fit the map only %.1f %% %s than the wheels measured them "
+                  "(more than %.1f %%): not this building, or wheels far off their calibration",
+                  100 * std::abs(fit.scale - 1), fit.scale > 1 ? "further apart" : "closer",
+                  100 * o.max_scale_change);
+    throw JobFailed(buf);
+  }
+  // The drive in the map's scale: its lamps, heights and keyframes (scale_drive), so that every
+  // step below sees it as the map would have it.
+  scale_drive(drive, fit.scale, Vector2d::Zero(), cam->mount.xyz.z());
+  out.drive_scale = fit.scale;
+  const Pose2 T = fit.motion;
   out.drive_to_map = T;
 
   // 2. Map lamps the ceiling camera had clearly in view, and how often. Only lamps of a kind the

@@ -1,9 +1,9 @@
 #pragma once
 // A drive against an existing map (`lampnav map survey`): the drive's lamps (lamp_mapper.hpp) put
-// onto the map by the rigid motion most of them agree on, then each map lamp the ceiling camera
-// had clearly in view judged: there (ok), not seen (failed), seen more than `moved_m` away
-// (moved); and each lamp of the drive no map lamp accounts for: new. Every finding says where,
-// as facility staff would: "C3, 4th lamp from J2".
+// onto the map by the rigid motion most of them agree on (and the scale of the map), then each map
+// lamp the ceiling camera had clearly in view judged: there (ok), not seen (failed), seen more than
+// `moved_m` away (moved); and each lamp of the drive no map lamp accounts for: new. Every finding
+// says where, as facility staff would: "C3, 4th lamp from J2".
 
 #include <optional>
 #include <string>
@@ -24,6 +24,12 @@ struct SurveyOptions {
   // Where the drive started in the map, if known: needed where the drive alone fits several
   // places (a regular building); the lamps then refine it.
   std::optional<Pose2> start;
+  // The map holds the building's scale, the drive its wheels' (a camera looking up cannot tell):
+  // the drive is scaled to the map, by at most this much (beyond it the survey fails: not this
+  // building, or wheels far off their calibration), when its lamps spread over at least
+  // `scale_extent_m` (RMS from their middle; over less, the scale is the wheels').
+  double max_scale_change = 0.02;
+  double scale_extent_m = 5.0;
   void validate() const;  // throws InputError naming the field
 };
 
@@ -44,7 +50,9 @@ struct SurveyResult {
   std::vector<SurveyFinding> findings;  // failed, moved and new lamps, by place
   int ok = 0;                           // map lamps seen where the map has them
   int judged = 0;                       // map lamps the drive had clearly in view
-  Pose2 drive_to_map;                   // the drive's frame onto the map's
+  Pose2 drive_to_map;                   // the drive's frame, once scaled, onto the map's
+  double drive_scale = 1;               // the drive scaled by this to fit the map: its wheels
+                                        // read 1 / drive_scale - 1 long
   double alignment_rms_m = 0;           // of the lamps that agreed
   int agreeing = 0;
   graph::TopologicalMap updated;  // the map with moved lamps moved, new ones added, failed ones
