@@ -174,7 +174,9 @@ TEST(MapBuild, AMeasuredDistanceGivesTheMapItsScale) {
     return lamp_errors(graph::read_map(path).map, truth, start, 1.0);
   };
   const std::string build = "map build '" + rec.log + "' -o '" + out + "' --quiet";
-  ASSERT_EQ(test::run_lampnav(build).status, 0);
+  const auto plain = test::run_lampnav(build);
+  ASSERT_EQ(plain.status, 0) << plain.err;
+  EXPECT_THAT(plain.err, HasSubstr("scale is the wheels' calibration"));
   const LampErrors before = errors(out);
   std::cout << "wheels 1 % long: error rms " << before.rms * 100 << " cm, max "
             << before.worst * 100 << " cm\n";
