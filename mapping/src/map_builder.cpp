@@ -11,6 +11,7 @@
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "median.hpp"
+#include "view_jumps.hpp"
 
 namespace lampnav::mapping {
 
@@ -211,10 +212,34 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
   if (progress) progress(0.9);
   out.detect_seconds = since(t0);
   const auto t1 = std::chrono::steady_clock::now();
+  const auto& wheels = log.wheels;
+  // Where the view jumps (the robot carried): the drive up to there only.
+  std::size_t kept = frames.size();
+  {
+    std::vector<ViewFrame> view(frames.size());
+    std::size_t w = 0;
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      view[i].stamp = frames[i]->value.stamp;
+      for (; w + 1 < wheels.size() && wheels[w + 1].value.stamp <= view[i].stamp; ++w) {
+      }
+      view[i].left = wheels[w].value.left;
+      view[i].right = wheels[w].value.right;
+      view[i].lamps = unreadable[i] ? nullptr : &detected[i];
+    }
+    if (const auto jump = first_view_jump(view, *cam, robot.semi_axis)) {
+      kept = *jump;
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    "the ceiling view jumped %.1f s into the drive as no driving could make it "
+                    "(the robot was carried): the map holds the drive up to there, %zu of %zu "
+                    "frames; map the rest from a drive of its own",
+                    to_seconds(view[kept].stamp - view.front().stamp), kept, frames.size());
+      out.notes.push_back(buf);
+    }
+  }
   LampMapper mapper(robot, o.mapper);
   std::size_t w = 0;
-  const auto& wheels = log.wheels;
-  for (std::size_t i = 0; i < frames.size(); ++i) {
+  for (std::size_t i = 0; i < kept; ++i) {
     const Stamp t = frames[i]->value.stamp;
     for (; w < wheels.size() && wheels[w].value.stamp <= t; ++w)
       mapper.wheels(wheels[w].value.stamp, wheels[w].value.left, wheels[w].value.right);
@@ -276,7 +301,8 @@ MapBuildResult build_map(const io::MissionLog& log, const std::string& source,
     out.map = build_topology(out.mapped, o.topology, names, &out.topology);
     out.topology.notes.insert(out.topology.notes.end(), scale_notes.begin(), scale_notes.end());
   }
-  out.notes = out.topology.notes;
+  // The drive's notes (frames skipped, a jump of the view) first, then the places'.
+  out.notes.insert(out.notes.end(), out.topology.notes.begin(), out.topology.notes.end());
   if (out.mapped.revisits == 0)
     out.notes.push_back(
         "the drive never came back to a lamp it had left: no loop closed, so "
@@ -285,9 +311,6 @@ MapBuildResult build_map(const io::MissionLog& log, const std::string& source,
     out.notes.push_back(
         "the map's scale is the wheels' calibration (0.1 % off is 10 cm in 100 m): measure the "
         "distance between two lamps far apart and build again with --distance FROM,TO,METRES");
-  if (out.unreadable_frames)
-    out.notes.push_back(std::to_string(out.unreadable_frames) +
-                        " ceiling frames could not be decoded and were skipped");
   return out;
 }
 

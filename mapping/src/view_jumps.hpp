@@ -1,0 +1,39 @@
+#pragma once
+// Where a drive's ceiling view jumps as no driving could make it: the robot lifted and put down
+// elsewhere (a kidnap), which the wheels do not see. Private to mapping/: a map build keeps the
+// drive up to the first jump, since the lamps after it would be placed where the wheels say the
+// robot still is.
+
+#include <optional>
+#include <vector>
+
+#include "lampnav/core/robot_description.hpp"
+#include "lampnav/core/time.hpp"
+#include "lampnav/vision/lamp_detector.hpp"
+
+namespace lampnav::mapping {
+
+struct ViewJumpOptions {
+  double margin = 0.15;       // of the image size: a lamp this far inside cannot leave in one frame
+  double gate = 0.05;         // normalized: a lamp's centre moves at most this between frames, plus
+  double min_height_m = 1.0;  // the travel over this (lamps at least this far above the camera)
+                              // plus the turn times the lamp's distance from the axis (+ 0.3)
+};
+
+// One ceiling frame: when, the wheels' cumulative travel then, and what the detector found.
+struct ViewFrame {
+  Stamp stamp;
+  double left = 0, right = 0;                                 // m
+  const std::vector<vision::LampDetection>* lamps = nullptr;  // nullptr: unreadable
+};
+
+// The index of the first frame after a jump, or nullopt. A jump: between two frames with lamps
+// (frames without any are passed over), every lamp of the earlier one, whole or cut by the
+// border, is gone from where the wheels' motion could have taken it; a whole lamp well inside
+// the later one was nowhere near in the earlier one (a lamp does not appear in the middle of the
+// view by driving); and the next frame with lamps still shows the new view.
+std::optional<std::size_t> first_view_jump(const std::vector<ViewFrame>& frames,
+                                           const CameraDescription& camera, double semi_axis,
+                                           const ViewJumpOptions& options = {});
+
+}  // namespace lampnav::mapping

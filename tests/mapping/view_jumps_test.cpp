@@ -1,0 +1,90 @@
+// Where a drive's ceiling view jumps (the robot carried): found where a lamp appears in the middle
+// of the view with none of the lamps before still in it, and nowhere else: not while driving under
+// lamps, not for one bad frame, not for a lamp that goes out or comes on.
+
+#include "view_jumps.hpp"
+
+#include <gtest/gtest.h>
+
+#include "lampnav_test.hpp"
+
+namespace lampnav::mapping {
+namespace {
+
+const CameraDescription& camera() {
+  static const RobotDescription robot =
+      read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  return *robot.find_camera("ceiling_camera");
+}
+
+vision::LampDetection lamp(double x, double y, vision::LampView view = vision::LampView::full) {
+  const CameraDescription& c = camera();
+  vision::LampDetection d;
+  d.view = view;
+  d.centre = {x, y};
+  d.centre_px = {c.pinhole.cx + c.pinhole.fx * x, c.pinhole.cy + c.pinhole.fy * y};
+  return d;
+}
+
+// A drive at 0.5 m/s, frames at 10 Hz, the lamps of each frame given.
+struct Drive {
+  std::vector<std::vector<vision::LampDetection>> lamps;
+  std::vector<ViewFrame> frames() const {
+    std::vector<ViewFrame> out(lamps.size());
+    for (std::size_t i = 0; i < lamps.size(); ++i) {
+      out[i].stamp = stamp_from_seconds(0.1 * i);
+      out[i].left = out[i].right = 0.05 * i;
+      out[i].lamps = &lamps[i];
+    }
+    return out;
+  }
+};
+
+// Lamps 2.25 m apart under a 2.4 m ceiling stream across the view (0.02 normalized a frame):
+// each enters cut, crosses whole, leaves cut.
+Drive under_a_row_of_lamps(int frames) {
+  Drive d;
+  for (int i = 0; i < frames; ++i) {
+    std::vector<vision::LampDetection> f;
+    for (int k = 0; k < 4; ++k) {
+      const double x = 0.6 - 0.02 * i + 0.94 * k;
+      if (std::abs(x) < 0.3)
+        f.push_back(lamp(x, 0.0));
+      else if (std::abs(x) < 0.55)
+        f.push_back(lamp(x, 0.0, vision::LampView::completed));
+    }
+    d.lamps.push_back(f);
+  }
+  return d;
+}
+
+TEST(ViewJumps, DrivingUnderLampsIsNoJump) {
+  const Drive d = under_a_row_of_lamps(200);
+  EXPECT_FALSE(first_view_jump(d.frames(), camera(), 0.2));
+}
+
+TEST(ViewJumps, ALampInTheMiddleWhereNoneWasComingIsAJump) {
+  Drive d = under_a_row_of_lamps(60);
+  // Carried at frame 60: put down under another lamp, facing the other way.
+  for (int i = 0; i < 20; ++i) d.lamps.push_back({lamp(-0.1 + 0.02 * i, 0.01)});
+  const auto jump = first_view_jump(d.frames(), camera(), 0.2);
+  ASSERT_TRUE(jump);
+  EXPECT_EQ(*jump, 60u);
+}
+
+TEST(ViewJumps, OneBadFrameOrALampGoingOutOrComingOnIsNoJump) {
+  Drive glitch = under_a_row_of_lamps(120);
+  glitch.lamps[60] = {lamp(0.05, 0.2)};  // one frame: a reflection, the lamps missed
+  EXPECT_FALSE(first_view_jump(glitch.frames(), camera(), 0.2));
+
+  Drive out = under_a_row_of_lamps(120);
+  for (int i = 60; i < 120; ++i) out.lamps[i].clear();  // the lamp overhead fails, then dark
+  EXPECT_FALSE(first_view_jump(out.frames(), camera(), 0.2));
+
+  Drive on = under_a_row_of_lamps(120);
+  for (int i = 60; i < 120; ++i) on.lamps[i].push_back(lamp(0.0, 0.3));  // one comes on
+  EXPECT_FALSE(first_view_jump(on.frames(), camera(), 0.2));
+}
+
+}  // namespace
+}  // namespace lampnav::mapping
