@@ -41,10 +41,11 @@ Accuracy accuracy(const graph::TopologicalMap& built, const graph::TopologicalMa
                   const Pose2& start) {
   Accuracy a;
   Pose2 fit = start;
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> xy;  // the pairs' positions
   for (int round = 0; round < 2; ++round) {
     a.pairs.clear();
     a.phantoms = 0;
-    std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> xy;
+    xy.clear();
     for (const auto& n : built.nodes()) {
       for (const auto& l : n.lamps) {
         const auto near = truth.lamps_within(fit.transform_from(l.xyz.head<2>()), 0.5);
@@ -59,38 +60,23 @@ Accuracy accuracy(const graph::TopologicalMap& built, const graph::TopologicalMa
     fit = mapping::fit_rigid(xy);
   }
   if (a.pairs.empty()) return a;
-  double sum = 0, worst = 0, dz = 0;
-  Eigen::Vector2d cm = Eigen::Vector2d::Zero(), ct = Eigen::Vector2d::Zero();
+  // The best similarity: its rotation is the rigid fit's, its scale the one that fits on top.
+  const mapping::Similarity similar = mapping::fit_similarity(xy);
+  double sum = 0, worst = 0, dz = 0, sum_scaled = 0, worst_scaled = 0;
   for (const auto& [b, t] : a.pairs) {
-    const Eigen::Vector2d at = fit.transform_from(b->xyz.head<2>());
-    const double e = (at - t->xyz.head<2>()).norm();
+    const double e = (fit.transform_from(b->xyz.head<2>()) - t->xyz.head<2>()).norm();
     sum += e * e;
     worst = std::max(worst, e);
     dz = std::max(dz, std::abs(b->xyz.z() - t->xyz.z()));
-    cm += at;
-    ct += t->xyz.head<2>();
+    const double es = (similar.transform_from(b->xyz.head<2>()) - t->xyz.head<2>()).norm();
+    sum_scaled += es * es;
+    worst_scaled = std::max(worst_scaled, es);
   }
   const double n = static_cast<double>(a.pairs.size());
-  cm /= n;
-  ct /= n;
-  double num = 0, den = 0;
-  for (const auto& [b, t] : a.pairs) {
-    const Eigen::Vector2d at = fit.transform_from(b->xyz.head<2>()) - cm;
-    num += at.dot(t->xyz.head<2>() - ct);
-    den += at.squaredNorm();
-  }
-  const double scale = den > 0 ? num / den : 1;
-  double sum_scaled = 0, worst_scaled = 0;
-  for (const auto& [b, t] : a.pairs) {
-    const double e =
-        (ct + scale * (fit.transform_from(b->xyz.head<2>()) - cm) - t->xyz.head<2>()).norm();
-    sum_scaled += e * e;
-    worst_scaled = std::max(worst_scaled, e);
-  }
   a.rms_cm = 100 * std::sqrt(sum / n);
   a.max_cm = 100 * worst;
   a.height_max_cm = 100 * dz;
-  a.scale_error_percent = 100 * (scale - 1);
+  a.scale_error_percent = 100 * (similar.scale - 1);
   a.rms_scaled_cm = 100 * std::sqrt(sum_scaled / n);
   a.max_scaled_cm = 100 * worst_scaled;
   return a;

@@ -15,6 +15,15 @@
 
 namespace lampnav::mapping {
 
+namespace {
+
+// Where a measured distance came from, for messages: the user's flag, or its place in the options.
+ErrorContext where_given(const KnownDistance& d, std::size_t k) {
+  return {"", d.given_as.empty() ? "distances[" + std::to_string(k) + "]" : d.given_as, ""};
+}
+
+}  // namespace
+
 void MapBuildOptions::validate() const {
   mapper.validate();
   topology.validate();
@@ -30,8 +39,7 @@ void MapBuildOptions::validate() const {
     throw InputError({"map build options", "", "distance_tolerance_m"}, "must be from 0 to 10 m");
   for (std::size_t k = 0; k < distances.size(); ++k) {
     const KnownDistance& d = distances[k];
-    const ErrorContext where{
-        "", d.given_as.empty() ? "distances[" + std::to_string(k) + "]" : d.given_as, ""};
+    const ErrorContext where = where_given(d, k);
     if (d.from.empty() || d.to.empty()) throw InputError(where, "names no lamp");
     if (d.from == d.to) throw InputError(where, "names one lamp twice");
     if (!(std::isfinite(d.metres) && d.metres > 0))
@@ -78,8 +86,7 @@ double scale_for_distances(const graph::TopologicalMap& map, const MapBuildOptio
   std::vector<Pair> pairs;
   for (std::size_t k = 0; k < o.distances.size(); ++k) {
     const KnownDistance& d = o.distances[k];
-    const ErrorContext where{
-        "", d.given_as.empty() ? "distances[" + std::to_string(k) + "]" : d.given_as, ""};
+    const ErrorContext where = where_given(d, k);
     const graph::Lamp* lamps[2] = {map.find_lamp(LampId(d.from)), map.find_lamp(LampId(d.to))};
     for (int e = 0; e < 2; ++e)
       if (!lamps[e])
