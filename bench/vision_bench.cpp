@@ -105,6 +105,12 @@ void BM_LampDetectAndTrack(benchmark::State& state) {
   detect_and_track(state, vision::LampTrackerOptions{}.full_detection_every);
 }
 BENCHMARK(BM_LampDetectAndTrack)->Arg(352)->Arg(640)->Unit(benchmark::kMicrosecond);
+// Two laps of the drive exactly (680 frames): the run that instruction counts are taken from,
+// the same frames in every program compared (docs/performance.md):
+//   valgrind --tool=callgrind --toggle-collect='lampnav::vision::LampTracker::process*'
+//   build/bench/vision_bench --benchmark_filter='BM_LampDetectAndTrackTwoLaps/352'
+void BM_LampDetectAndTrackTwoLaps(benchmark::State& state) { BM_LampDetectAndTrack(state); }
+BENCHMARK(BM_LampDetectAndTrackTwoLaps)->Arg(352)->Arg(640)->Iterations(680);
 
 void BM_LampDetectAndTrackWholeFrames(benchmark::State& state) { detect_and_track(state, 1); }
 BENCHMARK(BM_LampDetectAndTrackWholeFrames)->Arg(352)->Arg(640)->Unit(benchmark::kMicrosecond);
