@@ -143,5 +143,55 @@ TEST(RunOpening, SamePixelsAsTheDefinitionOnLampLikeMasks) {
   EXPECT_GT(single_rows, rows * 3 / 5);
 }
 
+// Masks of one span a row (or none), the lamp's usual mask, which the opening takes without
+// intermediate masks: bars of every slope, and staircases of random steps, whose rows the
+// dilation can split in two (two squares inside the mask that share rows but not columns).
+TEST(RunOpening, SamePixelsAsTheDefinitionOnMasksOfOneSpanARow) {
+  std::mt19937 rng(5);
+  RunOpening opening;
+  RunMask out;
+  int cases = 0, split = 0;
+  for (int r = 1; r <= 5; ++r) {
+    for (int trial = 0; trial < 40; ++trial) {
+      const bool stairs = trial % 2 == 0;
+      const int w = (stairs ? 40 : 8) + static_cast<int>(rng() % 60);
+      const int h = 3 + static_cast<int>(rng() % 40);
+      Bytes m(static_cast<std::size_t>(w) * h, 0);
+      const double slope = (static_cast<int>(rng() % 600) - 300) / 100.0;
+      const int half = static_cast<int>(rng() % (w / 2 + 1));
+      int a = 0, b = -1, step_left = 0, step = 0;
+      const int side = 2 * r + 1 + static_cast<int>(rng() % 4), gap = 1 + trial % 3;
+      for (int y = 0; y < h; ++y) {
+        if (stairs && step_left-- <= 0) {
+          // The next step: left, across, right, across, left...; a side step 2r + 1 to 2r + 4
+          // wide and r + 1 to 2r + 1 high, 1 to 3 pixels apart, a step across r to 2r high (no
+          // square fits in it).
+          const int kind = step++ % 4;
+          const bool across = kind % 2 == 1;
+          step_left =
+              across ? r + static_cast<int>(rng() % r) : r + static_cast<int>(rng() % (r + 1));
+          a = kind == 2 ? 2 + side + gap : 2;
+          b = std::min(w - 1, kind == 0 ? 1 + side : 1 + 2 * side + gap);
+        } else if (!stairs) {
+          const int mid = w / 2 + static_cast<int>(slope * (y - h / 2));
+          a = std::max(0, mid - half + static_cast<int>(rng() % 3) - 1);
+          b = std::min(w - 1, mid + half + static_cast<int>(rng() % 3) - 1);
+        }
+        if (rng() % 15 == 0) continue;  // an empty row
+        for (int x = a; x <= b; ++x) m[static_cast<std::size_t>(y) * w + x] = 1;
+      }
+      const RunMask in = runs_of(m, w, h);
+      for (int y = 0; y < h; ++y) ASSERT_LE(in.row_end(y) - in.row_begin(y), 1);
+      opening.open(in, r, out);
+      ASSERT_EQ(bytes_of(out), opened_by_definition(m, w, h, r))
+          << "r " << r << ", " << w << " x " << h << ", trial " << trial;
+      for (int y = 0; y < h; ++y) split += out.row_end(y) - out.row_begin(y) > 1 ? 1 : 0;
+      ++cases;
+    }
+  }
+  EXPECT_EQ(cases, 200);
+  EXPECT_GT(split, 100);  // rows the dilation split: the join's other outcome is tested too
+}
+
 }  // namespace
 }  // namespace lampnav::vision::detail

@@ -72,7 +72,8 @@ void add_joined(const Span* first, const Span* last, RunMask& out) {
   out.add(cur.a, cur.b);
 }
 
-constexpr int kMaxDirect = 15;  // rows joined without the general merge: radius 7 at most
+constexpr int kMaxDirect = 15;           // rows joined without the general merge: radius 7 at most
+constexpr int kMaxSingleSpanRadius = 5;  // the detector's options allow no more
 
 // Rows y0..y1 (inclusive) hold at most one span each; `empty` is set when one holds none.
 bool single_spans(const RunMask& in, int y0, int y1, bool& empty) {
@@ -134,7 +135,68 @@ void along_columns(const RunMask& in, int r, bool erode, RunMask& out, std::vect
 
 }  // namespace
 
+bool RunOpening::open_single_spans(const RunMask& in, int r, RunMask& out) {
+  const int w = in.width(), h = in.height();
+  // Erosion along rows: each span shrunk by r at both ends. A lamp's fringe (spans of 2r pixels
+  // or fewer beside it, gaps near its ends) is gone after it; a row left with two spans is not
+  // taken here.
+  eroded_rows_.assign(static_cast<std::size_t>(h), Span{1, 0});
+  for (int y = 0; y < h; ++y) {
+    for (const Span* s = in.row_begin(y); s != in.row_end(y); ++s) {
+      if (s->b - s->a < 2 * r) continue;
+      if (eroded_rows_[y].a <= eroded_rows_[y].b) return false;
+      eroded_rows_[y] = {s->a + r, s->b - r};
+    }
+  }
+  // Along columns: row y's span is the intersection of rows y - r .. y + r (empty as soon as one
+  // is), for y in [r, h - r); then grown by r along the row, kept off the r pixels at either end.
+  // An eroded span lies in [r, w - 1 - r], so growing and clipping it cannot empty it.
+  grown_.assign(static_cast<std::size_t>(h), Span{1, 0});
+  for (int y = r; y < h - r; ++y) {
+    int a = 0, b = w - 1;
+    for (int j = y - r; j <= y + r && a <= b; ++j) {
+      a = std::max(a, eroded_rows_[j].a);
+      b = std::min(b, eroded_rows_[j].b);
+    }
+    if (a <= b) grown_[y] = {std::max(a - r, r), std::min(b + r, w - 1 - r)};
+  }
+  // Dilation along columns: row y is the union of the grown spans of rows y - r .. y + r. When
+  // every two of them overlap or touch (the usual case: a lamp's rows), it is one span from the
+  // least start to the greatest end; otherwise they are sorted and joined.
+  out.reset(w, h);
+  for (int y = 0; y < h; ++y) {
+    out.begin_row();
+    if (y < r || y >= h - r) continue;
+    int n = 0, lo = w, hi = -1, last_start = -1, first_end = w;
+    for (int j = y - r; j <= y + r; ++j) {
+      const Span s = grown_[j];
+      if (s.a > s.b) continue;
+      ++n;
+      lo = std::min(lo, s.a), hi = std::max(hi, s.b);
+      last_start = std::max(last_start, s.a), first_end = std::min(first_end, s.b);
+    }
+    if (n == 0) continue;
+    if (last_start <= first_end + 1) {
+      out.add(lo, hi);
+      continue;
+    }
+    std::array<Span, 2 * kMaxSingleSpanRadius + 1> sorted;
+    n = 0;
+    for (int j = y - r; j <= y + r; ++j) {
+      const Span s = grown_[j];
+      if (s.a > s.b) continue;
+      int k = n++;
+      for (; k > 0 && sorted[k - 1].a > s.a; --k) sorted[k] = sorted[k - 1];
+      sorted[k] = s;
+    }
+    add_joined(sorted.data(), sorted.data() + n, out);
+  }
+  out.end_rows();
+  return true;
+}
+
 void RunOpening::open(const RunMask& in, int r, RunMask& out) {
+  if (r <= kMaxSingleSpanRadius && open_single_spans(in, r, out)) return;
   along_rows(in, r, true, rows_);
   along_columns(rows_, r, true, eroded_, a_, b_);
   along_rows(eroded_, r, false, dilated_rows_);

@@ -39,8 +39,13 @@ class RunOpening {
   void open(const RunMask& in, int r, RunMask& out);
 
  private:
+  // A mask left with at most one span in every row by the erosion along rows (a lamp, with or
+  // without a fringe): the erosion along columns and the dilation are then done on two ints a
+  // row, without intermediate masks. False, `out` untouched, for any other mask.
+  bool open_single_spans(const RunMask& in, int r, RunMask& out);
   RunMask rows_, eroded_, dilated_rows_;
   std::vector<Span> a_, b_;
+  std::vector<Span> eroded_rows_, grown_;  // open_single_spans: a span a row, a > b when none
 };
 
 }  // namespace lampnav::vision::detail
