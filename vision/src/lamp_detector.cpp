@@ -78,25 +78,40 @@ struct LampDetector::Impl {
   int w, h;
   // Per pixel: undistorted normalized coordinates of its centre and the normalized area it covers.
   std::vector<float> lut_x, lut_y, lut_w;
-  // Per row, running sums of the moments' terms over its first 8k pixels (k = 0..w/8), so that
-  // a run of pixels costs two lookups and at most 14 pixels' terms, not one term per pixel. One
-  // cache line an entry: 0.8 MB at 352x288, 2.5 MB at 640x480.
-  static constexpr int kSumStride = 8;
+  // Per row, running sums of the moments' terms over its first 4k pixels (k = 0..w/4), so that
+  // a run of pixels costs two lookups and at most four pixels' terms (the nearer entry, before or
+  // after the run's end), not one term per pixel. One cache line an entry: 1.6 MB at 352x288,
+  // 4.9 MB at 640x480.
+  static constexpr int kSumStride = 4;
   struct alignas(64) RowSums {
     double w = 0, wx = 0, wy = 0, wxx = 0, wxy = 0, wyy = 0, ww = 0;
     void add(double wt, double x, double y) {
       w += wt, wx += wt * x, wy += wt * y;
       wxx += wt * x * x, wxy += wt * x * y, wyy += wt * y * y, ww += wt * wt;
     }
+    void remove(double wt, double x, double y) {
+      w -= wt, wx -= wt * x, wy -= wt * y;
+      wxx -= wt * x * x, wxy -= wt * x * y, wyy -= wt * y * y, ww -= wt * wt;
+    }
   };
   int sums_per_row = 0;
   std::vector<RowSums> row_sums;
-  // The sums over pixels [0, u) of row v.
+  // The sums over pixels [0, u) of row v, 0 <= u <= w.
   RowSums sums_before(int u, int v) const {
-    RowSums s = row_sums[static_cast<std::size_t>(v) * sums_per_row + u / kSumStride];
-    for (int k = u - u % kSumStride; k < u; ++k) {
-      const std::size_t i = index(k, v);
-      s.add(lut_w[i], lut_x[i], lut_y[i]);
+    const RowSums* row = row_sums.data() + static_cast<std::size_t>(v) * sums_per_row;
+    const int k = u / kSumStride, past = u % kSumStride;
+    if (past <= kSumStride / 2 || k + 1 >= sums_per_row) {
+      RowSums s = row[k];
+      for (int j = u - past; j < u; ++j) {
+        const std::size_t i = index(j, v);
+        s.add(lut_w[i], lut_x[i], lut_y[i]);
+      }
+      return s;
+    }
+    RowSums s = row[k + 1];
+    for (int j = u; j < (k + 1) * kSumStride; ++j) {
+      const std::size_t i = index(j, v);
+      s.remove(lut_w[i], lut_x[i], lut_y[i]);
     }
     return s;
   }
@@ -107,10 +122,8 @@ struct LampDetector::Impl {
   detail::BlobLabeller blobs;
   detail::RunMask mask_runs, opened_runs;
   detail::RunOpening opening;
-  std::vector<std::uint8_t> opened;
   detail::EdgePoints edges;
-  std::vector<char> fit_use;               // fit_shape: which edge points are still in the fit
-  std::vector<std::pair<int, int>> visit;  // complete: a row's columns to look at
+  std::vector<char> fit_use;  // fit_shape: which edge points are still in the fit
 
   Impl(const CameraDescription& camera, const LampShapePrior& p, const LampDetectorOptions& opt)
       : model(camera), prior(p), o(opt), w(camera.width), h(camera.height) {
@@ -464,14 +477,6 @@ bool LampDetector::Impl::complete(const detail::Blob& c, const ImageView& g, int
                                   const detail::RunMask& open, LampDetection& out) {
   edges.clear();
   const double level = o.threshold - 0.5;
-  // The opened mask of measure(), padded: a pixel's 4-neighbours are always in it. Inside the
-  // image it is the visible lamp exactly (its extension past a cut lies outside the image).
-  const int mw = c.u1 - c.u0 + 1 + 2 * pad, mh = c.v1 - c.v0 + 1 + 2 * pad;
-  opened.assign(static_cast<std::size_t>(mw) * mh, 0);
-  for (int y = 0; y < mh; ++y)
-    for (const detail::Span* sp = open.row_begin(y); sp != open.row_end(y); ++sp)
-      std::memset(opened.data() + static_cast<std::size_t>(y) * mw + sp->a, 1,
-                  static_cast<std::size_t>(sp->b - sp->a + 1));
   auto edge = [&](int u, int v, int un, int vn, std::uint8_t gi, std::uint8_t go) {
     const double t = gi > go ? std::clamp((gi - level) / (gi - go), 0.0, 1.0) : 0.5;
     const std::size_t a = index(u, v), b = index(un, vn);
@@ -482,60 +487,61 @@ bool LampDetector::Impl::complete(const detail::Blob& c, const ImageView& g, int
   int border_n = 0;
   const std::size_t stride = g.row_stride();
   const int box_w = c.u1 - c.u0 + 1;
+  // The opened mask of measure(), as runs, padded: a pixel's 4-neighbours are always in it.
+  // Inside the image it is the visible lamp exactly (its extension past a cut lies outside the
+  // image), and its runs neither overlap nor touch: a pixel has a dark left (right) neighbour
+  // exactly when it starts (ends) a run, and a dark neighbour above (below) when no run of that
+  // row covers it. Each run is walked in stretches over which that stays the same; the pixels
+  // of a stretch with a dark neighbour above or below, on the image's top or bottom row, and
+  // each run's ends are looked at, in column order, as the pixels of the row.
   for (int v = c.v0; v <= c.v1; ++v) {
     const int y = v - c.v0 + pad;
-    const std::uint8_t* row = opened.data() + static_cast<std::size_t>(y) * mw + pad;
     const std::uint8_t* grey_row = g.data + static_cast<std::size_t>(v) * stride;
     const bool border_row = v == 0 || v == h - 1;
-    // The pixels that can be on an edge or the image's border, from the runs: each run's ends,
-    // its stretches not under a run of the row above or below, and all of it on the image's top
-    // or bottom row (an end of a run is also where it meets the image's first or last column).
-    // Columns j = u - c.u0, in the blob's box; visited in order, as the pixels of the row.
-    visit.clear();
+    // The runs of the rows above and below, passed over as the columns grow.
+    const detail::Span* up = open.row_begin(y - 1);
+    const detail::Span* const up_end = open.row_end(y - 1);
+    const detail::Span* down = open.row_begin(y + 1);
+    const detail::Span* const down_end = open.row_end(y + 1);
     for (const detail::Span* sp = open.row_begin(y); sp != open.row_end(y); ++sp) {
+      // Columns j = u - c.u0, in the blob's box.
       const int a = std::max(sp->a - pad, 0), b = std::min(sp->b - pad, box_w - 1);
       if (a > b) continue;
-      if (border_row) {
-        visit.push_back({a, b});
-        continue;
-      }
-      visit.push_back({a, a});
-      visit.push_back({b, b});
-      for (const int other : {y - 1, y + 1}) {
-        int from = a;
-        for (const detail::Span* t = open.row_begin(other); t != open.row_end(other); ++t) {
-          const int ta = t->a - pad, tb = t->b - pad;
-          if (tb < from) continue;
-          if (ta > b) break;
-          if (ta > from) visit.push_back({from, ta - 1});
-          from = std::max(from, tb + 1);
-          if (from > b) break;
+      for (int j = a; j <= b;) {
+        // Whether the row above covers column j, and the first column where that changes.
+        while (up != up_end && up->b - pad < j) ++up;
+        const bool up_set = up != up_end && up->a - pad <= j;
+        const int up_next = up == up_end ? b + 1 : up_set ? up->b - pad + 1 : up->a - pad;
+        while (down != down_end && down->b - pad < j) ++down;
+        const bool down_set = down != down_end && down->a - pad <= j;
+        const int down_next = down == down_end ? b + 1
+                              : down_set       ? down->b - pad + 1
+                                               : down->a - pad;
+        const int last = std::min({b, up_next - 1, down_next - 1});
+        const bool above = v > 0 && !up_set, below = v < h - 1 && !down_set;
+        for (int k = j; k <= last; ++k) {
+          // Inside a stretch with nothing dark above or below, only the run's ends.
+          if (!(above || below || border_row) && k != a && k != b) {
+            k = std::max(k, std::min(last, b - 1));
+            continue;
+          }
+          const int u = c.u0 + k;
+          const bool left = k == a && u > 0, right = k == b && u < w - 1;
+          if (border_row || u == 0 || u == w - 1) {
+            const std::size_t i = index(u, v);
+            border_sum += Vector2d(lut_x[i], lut_y[i]);
+            ++border_n;
+          }
+          if (!(left || right || below || above)) continue;
+          const std::uint8_t gi = grey_row[u];
+          // The neighbours in the order right, left, below, above.
+          if (right) edge(u, v, u + 1, v, gi, grey_row[u + 1]);
+          if (left) edge(u, v, u - 1, v, gi, grey_row[u - 1]);
+          if (below) edge(u, v, u, v + 1, gi, (grey_row + stride)[u]);
+          if (above) edge(u, v, u, v - 1, gi, (grey_row - stride)[u]);
         }
-        if (from <= b) visit.push_back({from, b});
+        j = last + 1;
       }
-    }
-    std::sort(visit.begin(), visit.end());
-    int next = 0;  // the first column not visited yet
-    for (const auto& [first, last] : visit) {
-      for (int j = std::max(first, next); j <= last; ++j) {
-        const int u = c.u0 + j;
-        const bool left = u > 0 && !row[j - 1], right = u < w - 1 && !row[j + 1];
-        const bool below = v < h - 1 && !row[j + mw], above = v > 0 && !row[j - mw];
-        const bool at_border = u == 0 || v == 0 || u == w - 1 || v == h - 1;
-        if (at_border) {
-          const std::size_t i = index(u, v);
-          border_sum += Vector2d(lut_x[i], lut_y[i]);
-          ++border_n;
-        }
-        if (!(left || right || below || above)) continue;
-        const std::uint8_t gi = grey_row[u];
-        // The neighbours in the order right, left, below, above.
-        if (right) edge(u, v, u + 1, v, gi, grey_row[u + 1]);
-        if (left) edge(u, v, u - 1, v, gi, grey_row[u - 1]);
-        if (below) edge(u, v, u, v + 1, gi, (grey_row + stride)[u]);
-        if (above) edge(u, v, u, v - 1, gi, (grey_row - stride)[u]);
-      }
-      next = std::max(next, last + 1);
     }
   }
   if (edges.size() < 16 || border_n == 0) return false;
