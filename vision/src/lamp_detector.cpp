@@ -498,33 +498,30 @@ bool LampDetector::Impl::complete(const detail::Blob& c, const ImageView& g, int
     const int y = v - c.v0 + pad;
     const std::uint8_t* grey_row = g.data + static_cast<std::size_t>(v) * stride;
     const bool border_row = v == 0 || v == h - 1;
-    // The runs of the rows above and below, passed over as the columns grow.
-    const detail::Span* up = open.row_begin(y - 1);
-    const detail::Span* const up_end = open.row_end(y - 1);
-    const detail::Span* down = open.row_begin(y + 1);
-    const detail::Span* const down_end = open.row_end(y + 1);
+    // The runs of the rows above and below, passed over as the columns grow: whether one covers
+    // column j, and the first column (up to b + 1) where that changes.
+    struct Cover {
+      const detail::Span *at, *end;
+      bool set = false;
+      int next = 0;
+    };
+    Cover up{open.row_begin(y - 1), open.row_end(y - 1)};
+    Cover down{open.row_begin(y + 1), open.row_end(y + 1)};
+    const auto advance = [pad](Cover& t, int j, int b) {
+      while (t.at != t.end && t.at->b - pad < j) ++t.at;
+      t.set = t.at != t.end && t.at->a - pad <= j;
+      t.next = t.at == t.end ? b + 1 : t.set ? t.at->b - pad + 1 : t.at->a - pad;
+    };
     for (const detail::Span* sp = open.row_begin(y); sp != open.row_end(y); ++sp) {
       // Columns j = u - c.u0, in the blob's box.
       const int a = std::max(sp->a - pad, 0), b = std::min(sp->b - pad, box_w - 1);
       if (a > b) continue;
       for (int j = a; j <= b;) {
-        // Whether the row above covers column j, and the first column where that changes.
-        while (up != up_end && up->b - pad < j) ++up;
-        const bool up_set = up != up_end && up->a - pad <= j;
-        const int up_next = up == up_end ? b + 1 : up_set ? up->b - pad + 1 : up->a - pad;
-        while (down != down_end && down->b - pad < j) ++down;
-        const bool down_set = down != down_end && down->a - pad <= j;
-        const int down_next = down == down_end ? b + 1
-                              : down_set       ? down->b - pad + 1
-                                               : down->a - pad;
-        const int last = std::min({b, up_next - 1, down_next - 1});
-        const bool above = v > 0 && !up_set, below = v < h - 1 && !down_set;
-        for (int k = j; k <= last; ++k) {
-          // Inside a stretch with nothing dark above or below, only the run's ends.
-          if (!(above || below || border_row) && k != a && k != b) {
-            k = std::max(k, std::min(last, b - 1));
-            continue;
-          }
+        advance(up, j, b);
+        advance(down, j, b);
+        const int last = std::min({b, up.next - 1, down.next - 1});
+        const bool above = v > 0 && !up.set, below = v < h - 1 && !down.set;
+        const auto look = [&](int k) {
           const int u = c.u0 + k;
           const bool left = k == a && u > 0, right = k == b && u < w - 1;
           if (border_row || u == 0 || u == w - 1) {
@@ -532,13 +529,20 @@ bool LampDetector::Impl::complete(const detail::Blob& c, const ImageView& g, int
             border_sum += Vector2d(lut_x[i], lut_y[i]);
             ++border_n;
           }
-          if (!(left || right || below || above)) continue;
+          if (!(left || right || below || above)) return;
           const std::uint8_t gi = grey_row[u];
           // The neighbours in the order right, left, below, above.
           if (right) edge(u, v, u + 1, v, gi, grey_row[u + 1]);
           if (left) edge(u, v, u - 1, v, gi, grey_row[u - 1]);
           if (below) edge(u, v, u, v + 1, gi, (grey_row + stride)[u]);
           if (above) edge(u, v, u, v - 1, gi, (grey_row - stride)[u]);
+        };
+        if (above || below || border_row) {
+          for (int k = j; k <= last; ++k) look(k);
+        } else {
+          // Nothing dark above or below: only the run's ends, where the stretch holds them.
+          if (j == a) look(a);
+          if (last == b && b != a) look(b);
         }
         j = last + 1;
       }

@@ -74,6 +74,23 @@ void add_joined(const Span* first, const Span* last, RunMask& out) {
 
 constexpr int kMaxDirect = 15;           // rows joined without the general merge: radius 7 at most
 constexpr int kMaxSingleSpanRadius = 5;  // the detector's options allow no more
+static_assert(2 * kMaxSingleSpanRadius + 1 <= kMaxDirect);
+
+// Up to kMaxDirect spans (one from each of 2r + 1 rows), kept sorted by their first column as
+// they come (insertion: a handful), then added to a row joined where they touch.
+class SortedSpans {
+ public:
+  void insert(const Span& s) {
+    int k = n_++;
+    for (; k > 0 && spans_[k - 1].a > s.a; --k) spans_[k] = spans_[k - 1];
+    spans_[k] = s;
+  }
+  void add_joined_to(RunMask& out) const { add_joined(spans_.data(), spans_.data() + n_, out); }
+
+ private:
+  std::array<Span, kMaxDirect> spans_;
+  int n_ = 0;
+};
 
 // Rows y0..y1 (inclusive) hold at most one span each; `empty` is set when one holds none.
 bool single_spans(const RunMask& in, int y0, int y1, bool& empty) {
@@ -107,17 +124,10 @@ void along_columns(const RunMask& in, int r, bool erode, RunMask& out, std::vect
         if (a <= b) out.add(a, b);
         continue;
       }
-      // Sorted by their first column (insertion: a handful), then joined where they touch.
-      std::array<Span, kMaxDirect> sorted;
-      int n = 0;
-      for (int j = y - r; j <= y + r; ++j) {
-        if (in.row_begin(j) == in.row_end(j)) continue;
-        const Span s = *in.row_begin(j);
-        int k = n++;
-        for (; k > 0 && sorted[k - 1].a > s.a; --k) sorted[k] = sorted[k - 1];
-        sorted[k] = s;
-      }
-      add_joined(sorted.data(), sorted.data() + n, out);
+      SortedSpans sorted;
+      for (int j = y - r; j <= y + r; ++j)
+        if (in.row_begin(j) != in.row_end(j)) sorted.insert(*in.row_begin(j));
+      sorted.add_joined_to(out);
       continue;
     }
     x.assign(in.row_begin(y - r), in.row_end(y - r));
@@ -180,16 +190,10 @@ bool RunOpening::open_single_spans(const RunMask& in, int r, RunMask& out) {
       out.add(lo, hi);
       continue;
     }
-    std::array<Span, 2 * kMaxSingleSpanRadius + 1> sorted;
-    n = 0;
-    for (int j = y - r; j <= y + r; ++j) {
-      const Span s = grown_[j];
-      if (s.a > s.b) continue;
-      int k = n++;
-      for (; k > 0 && sorted[k - 1].a > s.a; --k) sorted[k] = sorted[k - 1];
-      sorted[k] = s;
-    }
-    add_joined(sorted.data(), sorted.data() + n, out);
+    SortedSpans sorted;
+    for (int j = y - r; j <= y + r; ++j)
+      if (grown_[j].a <= grown_[j].b) sorted.insert(grown_[j]);
+    sorted.add_joined_to(out);
   }
   out.end_rows();
   return true;
