@@ -78,6 +78,23 @@ struct ScalePrior {
   double s;
 };
 
+// Where a carried robot's part of the drive was placed (by its lamps' fit to the map before it):
+// the keyframe's only tie to the rest until lamps both parts saw tie them in the solve.
+struct PlacedPrior {
+  PlacedPrior(const std::array<double, 3>& placed, double sigma_xy, double sigma_yaw)
+      : p(placed), sxy(sigma_xy), syaw(sigma_yaw) {}
+  template <class T>
+  bool operator()(const T* pose, T* r) const {
+    r[0] = (pose[0] - T(p[0])) / T(sxy);
+    r[1] = (pose[1] - T(p[1])) / T(sxy);
+    const T e = pose[2] - T(p[2]);
+    r[2] = atan2(sin(e), cos(e)) / T(syaw);
+    return true;
+  }
+  std::array<double, 3> p;
+  double sxy, syaw;
+};
+
 // A lamp's centre in the ceiling image: predicted by the camera geometry shared with the
 // localizer (numeric derivatives: one model, not a copy of it templated for autodiff).
 struct CentreFactor {
@@ -138,7 +155,15 @@ SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
       new ceres::AutoDiffCostFunction<ScalePrior, 1, 1>(new ScalePrior(o.wheel_scale_sigma)),
       nullptr, &pb.wheel_difference);
   if (!whole) problem.SetParameterBlockConstant(&pb.wheel_difference);
+  for (const auto& c : pb.carries) {
+    if (c.keyframe < std::max<std::size_t>(1, first_free)) continue;
+    add_pose(c.keyframe);
+    problem.AddResidualBlock(new ceres::AutoDiffCostFunction<PlacedPrior, 3, 3>(
+                                 new PlacedPrior(c.placed, o.carry_sigma_m, o.carry_sigma_yaw)),
+                             nullptr, pb.poses[c.keyframe].data());
+  }
   for (std::size_t k = std::max<std::size_t>(1, first_free); k < pb.poses.size(); ++k) {
+    if (pb.carried_to(k)) continue;  // the wheels did not see the carry
     const double d = std::max(1e-3, pb.travel[k] - pb.travel[k - 1]);
     const double sxy = std::max(5e-4, o.odometry_sigma_per_m * std::sqrt(d));
     const double syaw = std::max(2e-4, o.odometry_yaw_sigma_per_m * std::sqrt(d));

@@ -27,6 +27,18 @@ struct MappingProblem {
     double orientation = 0;                            // rad, image axis (rectangles)
   };
   std::vector<Sighting> sightings;
+  // Keyframes the robot was carried to (lifted and put down): no odometry from the keyframe
+  // before; held near where its part of the drive was placed until its lamps place it.
+  struct Carry {
+    std::size_t keyframe = 0;
+    std::array<double, 3> placed{};  // x, y, yaw
+  };
+  std::vector<Carry> carries;
+  bool carried_to(std::size_t keyframe) const {
+    for (const Carry& c : carries)
+      if (c.keyframe == keyframe) return true;
+    return false;
+  }
 };
 
 struct SolveReport {
@@ -34,7 +46,8 @@ struct SolveReport {
   double rms_px = 0;  // reprojection RMS over the sightings, in pixels
 };
 
-// Solves the problem in place; the first keyframe is held fixed (it is the map frame). With
+// Solves the problem in place; the first keyframe is held fixed (it is the map frame), a carry's
+// keyframe by a prior of `carry_sigma_m` and `carry_sigma_yaw` (LampMapperOptions). With
 // `first_free` > 0 only the keyframes from it on and the lamps they see move (their sightings
 // from earlier keyframes anchor them); the wheels and the building's axis are held. The shared
 // height of each kind of lamp is estimated by every solve.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 
 #include "back_end.hpp"
 #include "lampnav/core/error.hpp"
@@ -28,6 +29,8 @@ void LampMapperOptions::validate() const {
   check(orientation_sigma > 0, "orientation_sigma", "must be positive");
   check(odometry_sigma_per_m > 0, "odometry_sigma_per_m", "must be positive");
   check(odometry_yaw_sigma_per_m > 0, "odometry_yaw_sigma_per_m", "must be positive");
+  check(carry_sigma_m > 0, "carry_sigma_m", "must be positive");
+  check(carry_sigma_yaw > 0, "carry_sigma_yaw", "must be positive");
   check(huber_sigmas > 0, "huber_sigmas", "must be positive");
   check(wheel_scale_sigma > 0 && wheel_scale_sigma < 0.5, "wheel_scale_sigma", "must be 0 to 0.5");
   check(square_sigma > 0, "square_sigma", "must be positive");
@@ -66,6 +69,7 @@ struct LampMapper::Impl {
   bool square_set = false;
   bool revisited = false;  // a landmark seen again after a loop since the last whole solve
   double last_whole_m = -1e9;
+  std::optional<Pose2> carried_to;  // set by carried(): the next keyframe's pose
   MappingResult result;
 
   Impl(const RobotDescription& robot, const LampMapperOptions& options)
@@ -119,9 +123,12 @@ struct LampMapper::Impl {
     const Pose2 odo = track.at(t);
     const double travel = travel_at(t);
     const bool first = pb.poses.empty();
-    if (!first && travel - pb.travel.back() < o.keyframe_m) return;
-    const Pose2 est = estimate(odo);
+    if (!first && !carried_to && travel - pb.travel.back() < o.keyframe_m) return;
+    const bool carry = carried_to.has_value();
+    const Pose2 est = carry ? *carried_to : estimate(odo);
+    carried_to.reset();
     const int kf = static_cast<int>(pb.poses.size());
+    if (carry) pb.carries.push_back({pb.poses.size(), {est.x(), est.y(), est.yaw()}});
     pb.poses.push_back({est.x(), est.y(), est.yaw()});
     pb.odometry.push_back(odo);
     pb.wheels.push_back(wheels_at(t));
@@ -132,7 +139,7 @@ struct LampMapper::Impl {
     // is followed across the image from there, when that keyframe is near enough.
     const std::size_t last_end = pb.sightings.size();
     std::size_t last_first = last_end;
-    if (kf > 0 && travel - pb.travel[kf - 1] <= kFollowSteps * o.keyframe_m) {
+    if (kf > 0 && !carry && travel - pb.travel[kf - 1] <= kFollowSteps * o.keyframe_m) {
       while (last_first > 0 && pb.sightings[last_first - 1].keyframe == kf - 1) --last_first;
     }
     for (const auto& d : lamps) {
@@ -281,6 +288,8 @@ void LampMapper::wheels(Stamp stamp, double left, double right) {
 void LampMapper::ceiling(Stamp stamp, const std::vector<vision::LampDetection>& lamps) {
   impl_->add_frame(stamp, lamps);
 }
+
+void LampMapper::carried(const Pose2& pose) { impl_->carried_to = pose; }
 
 MappingResult LampMapper::finish() {
   Impl& m = *impl_;

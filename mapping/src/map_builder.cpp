@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
 #include "drive_scale.hpp"
 #include "lampnav/core/error.hpp"
@@ -11,6 +12,8 @@
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "median.hpp"
+#include "omni_choice.hpp"
+#include "part_placement.hpp"
 #include "view_jumps.hpp"
 
 namespace lampnav::mapping {
@@ -134,6 +137,153 @@ double scale_for_distances(const graph::TopologicalMap& map, const MapBuildOptio
   return s;
 }
 
+// Where each part of a drive after a carry starts in the map (the first part's frame): each part
+// mapped on its own, then put onto the lamps of the parts before it where they fit one place
+// only. nullopt for the first part and for a part left out; a note for the user on each carry.
+// The omni camera's lamps in each of the log's omni frames (none without an omni camera).
+std::vector<OmniView> omni_views(const io::MissionLog& log, const std::string& source,
+                                 const RobotDescription& robot) {
+  const CameraDescription* cam = robot.find_camera("omni_camera");
+  std::vector<const io::Logged<io::ImageFrame>*> frames;
+  for (const auto& f : log.omni_images)
+    if (f.value.frame_id == "omni_camera") frames.push_back(&f);
+  if (!cam || frames.empty()) return {};
+  std::vector<OmniView> views(frames.size());
+  std::vector<char> readable(frames.size(), 0);
+  for_each_index(
+      frames.size(), [&] { return vision::OmniLampDetector(*cam); },
+      [&](vision::OmniLampDetector& detector, std::size_t i) {
+        try {
+          const Image8 img = io::decode_image(frames[i]->value.data, source);
+          views[i] = {frames[i]->value.stamp, detector.detect(vision::ImageView::of(img))};
+          readable[i] = 1;
+        } catch (const std::exception&) {
+          // an unreadable or foreign omni frame tells nothing: left out
+        }
+      });
+  std::vector<OmniView> out;
+  for (std::size_t i = 0; i < views.size(); ++i)
+    if (readable[i]) out.push_back(std::move(views[i]));
+  return out;
+}
+
+template <class Feed>
+std::vector<std::optional<Pose2>> place_parts(
+    const io::MissionLog& log, const std::string& source, const RobotDescription& robot,
+    const MapBuildOptions& o, const std::vector<std::size_t>& starts, Feed& feed,
+    const std::vector<const io::Logged<io::ImageFrame>*>& frames, std::vector<std::string>& notes) {
+  const std::size_t parts = starts.size() - 1;
+  std::vector<std::optional<Pose2>> out(parts);
+  std::vector<MappingResult> alone;
+  for (std::size_t p = 0; p < parts && parts > 1; ++p) {
+    LampMapper mapper(robot, o.mapper);
+    feed(mapper, starts[p], starts[p + 1], false);
+    alone.push_back(mapper.finish());
+  }
+  if (parts == 1) return out;
+  PlacementOptions po;
+  {
+    // The ceiling camera's reach: half the tangent of its narrower half-angle.
+    const CameraDescription& c = *robot.find_camera("ceiling_camera");
+    const double half =
+        std::min({c.pinhole.cx, c.width - c.pinhole.cx, c.pinhole.cy * c.pinhole.fx / c.pinhole.fy,
+                  (c.height - c.pinhole.cy) * c.pinhole.fx / c.pinhole.fy});
+    po.sure_per_height = 0.5 * half / c.pinhole.fx;
+    po.camera_height_m = c.mount.xyz.z();
+  }
+  std::optional<std::vector<OmniView>> omni;  // detected when first needed
+  // The omni views taken while the frames [from, to) were.
+  auto views_during = [&](std::size_t from, std::size_t to) {
+    std::vector<const OmniView*> during;
+    for (const OmniView& v : *omni)
+      if (v.stamp >= frames[from]->value.stamp && v.stamp <= frames[to - 1]->value.stamp)
+        during.push_back(&v);
+    return during;
+  };
+  std::vector<MappedLamp> lamps = alone[0].lamps;
+  std::vector<KeyframePose> path = alone[0].keyframes;
+  auto seconds = [&](std::size_t i) {
+    return to_seconds(frames[i]->value.stamp - frames.front()->value.stamp);
+  };
+  for (std::size_t p = 1; p < parts; ++p) {
+    const MappingResult& part = alone[p];
+    Placement placed = place_part({&lamps, &path}, {&part.lamps, &part.keyframes}, po);
+    std::string told;  // how the omni camera told places alike apart
+    const CameraDescription* omni_camera = robot.find_camera("omni_camera");
+    if (placed.fitting > 1 && omni_camera) {
+      if (!omni) omni = omni_views(log, source, robot);
+      // The map so far holds the parts placed before this one: their views count as well.
+      std::vector<const OmniView*> before;
+      for (std::size_t q = 0; q < p; ++q)
+        if (q == 0 || out[q]) {
+          const auto v = views_during(starts[q], starts[q + 1]);
+          before.insert(before.end(), v.begin(), v.end());
+        }
+      const OmniChoice c =
+          choose_by_omni({&lamps, &path}, {&part.lamps, &part.keyframes}, placed.fits, before,
+                         views_during(starts[p], starts[p + 1]), *omni_camera);
+      char buf[240];
+      if (c.chosen) {
+        placed.motion = placed.fits[*c.chosen].motion;
+        placed.shared = placed.fits[*c.chosen].shared;
+        std::snprintf(buf, sizeof buf,
+                      "; of %d places its lamps fit alike, the omni camera's %d views miss %d "
+                      "lamps at this one, and at any other at least %d more",
+                      placed.fitting, c.views, c.fewest_missed, c.least_extra);
+      } else if (c.views > 0) {
+        std::snprintf(buf, sizeof buf,
+                      " (nor do the omni camera's %d views tell them apart: they miss %d lamps "
+                      "at the best, and only %d more at the next)",
+                      c.views, c.fewest_missed, c.least_extra);
+      }
+      told = c.views > 0 ? buf : "";
+    }
+    char head[200], tail[400];
+    std::snprintf(head, sizeof head,
+                  "the ceiling view jumped %.1f s into the drive as no driving could make it (the "
+                  "robot was carried): the drive after it, to %.1f s,",
+                  seconds(starts[p]), seconds(starts[p + 1] - 1));
+    if (placed.motion && !part.keyframes.empty()) {
+      const Pose2& T = *placed.motion;
+      out[p] = T * part.keyframes.front().pose;
+      for (MappedLamp l : part.lamps) {
+        l.xyz.head<2>() = T.transform_from(l.xyz.head<2>());
+        l.yaw = wrap_angle(l.yaw + T.yaw());
+        lamps.push_back(l);
+      }
+      const int n = static_cast<int>(part.keyframes.size());
+      for (int k = po.end_keyframes; k + po.end_keyframes < n; ++k)
+        path.push_back({part.keyframes[k].stamp, T * part.keyframes[k].pose,
+                        part.keyframes[k].dead_reckoned, part.keyframes[k].travel_m});
+      std::snprintf(tail, sizeof tail,
+                    " is in the map: %d of its lamps fall on lamps mapped before it%s",
+                    placed.shared, told.empty() ? " at one place only" : told.c_str());
+    } else if (placed.fitting == 0) {
+      std::snprintf(tail, sizeof tail,
+                    " is not in the map: its %zu lamps fit nowhere on the %zu mapped before it "
+                    "(too few seen by both); map it from a drive of its own, or drive there "
+                    "without lifting the robot",
+                    part.lamps.size(), lamps.size());
+    } else {
+      std::string where;
+      for (std::size_t k = 0; k < std::min<std::size_t>(4, placed.fits.size()); ++k) {
+        const Pose2& T = placed.fits[k].motion;
+        const Pose2 at = part.keyframes.empty() ? T : T * part.keyframes.front().pose;
+        char buf[80];
+        std::snprintf(buf, sizeof buf, "%s(%.1f, %.1f) facing %.0f deg", where.empty() ? "" : ", ",
+                      at.x(), at.y(), at.yaw() * 180 / M_PI);
+        where += buf;
+      }
+      std::snprintf(tail, sizeof tail,
+                    " is not in the map: its lamps fit %d places of the map before it alike (a "
+                    "regular building; put down at %s%s)%s; drive there without lifting the robot",
+                    placed.fitting, where.c_str(), placed.fitting > 4 ? ", ..." : "", told.c_str());
+    }
+    notes.push_back(std::string(head) + tail);
+  }
+  return out;
+}
+
 }  // namespace
 
 DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
@@ -220,8 +370,9 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
   out.detect_seconds = since(t0);
   const auto t1 = std::chrono::steady_clock::now();
   const auto& wheels = log.wheels;
-  // Where the view jumps (the robot carried): the drive up to there only.
-  std::size_t kept = frames.size();
+  // Where the view jumps (the robot carried): the parts between are mapped apart, each joined to
+  // the map of the drive before it only where its lamps fit one place.
+  std::vector<std::size_t> starts{0};
   {
     std::vector<ViewFrame> view(frames.size());
     std::size_t w = 0;
@@ -233,30 +384,35 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
       view[i].right = wheels[w].value.right;
       view[i].lamps = unreadable[i] ? nullptr : &detected[i];
     }
-    if (const auto jump = first_view_jump(view, *cam, robot.semi_axis)) {
-      kept = *jump;
-      char buf[320];
-      std::snprintf(buf, sizeof buf,
-                    "the ceiling view jumped %.1f s into the drive as no driving could make it "
-                    "(the robot was carried): the map holds the drive up to there, %zu of %zu "
-                    "frames; map the rest from a drive of its own",
-                    to_seconds(view[kept].stamp - view.front().stamp), kept, frames.size());
-      out.notes.push_back(buf);
-    }
+    for (const std::size_t jump : view_jumps(view, *cam, robot.semi_axis)) starts.push_back(jump);
   }
-  LampMapper mapper(robot, o.mapper);
-  std::size_t w = 0;
-  for (std::size_t i = 0; i < kept; ++i) {
-    const Stamp t = frames[i]->value.stamp;
-    for (; w < wheels.size() && wheels[w].value.stamp <= t; ++w)
-      mapper.wheels(wheels[w].value.stamp, wheels[w].value.left, wheels[w].value.right);
-    ++out.frames;
-    if (unreadable[i]) {
-      ++out.unreadable_frames;
-      continue;
+  const std::size_t parts = starts.size();
+  starts.push_back(frames.size());
+  // Frames [from, to) into a mapper, with the wheels from the last reading before them on.
+  auto feed = [&](LampMapper& mapper, std::size_t from, std::size_t to, bool count) {
+    std::size_t w = 0;
+    while (w + 1 < wheels.size() && wheels[w + 1].value.stamp <= frames[from]->value.stamp) ++w;
+    for (std::size_t i = from; i < to; ++i) {
+      const Stamp t = frames[i]->value.stamp;
+      for (; w < wheels.size() && wheels[w].value.stamp <= t; ++w)
+        mapper.wheels(wheels[w].value.stamp, wheels[w].value.left, wheels[w].value.right);
+      if (count) ++out.frames;
+      if (unreadable[i]) {
+        if (count) ++out.unreadable_frames;
+        continue;
+      }
+      if (count)
+        for (const auto& d : detected[i]) out.lamps_seen_whole += d.view == vision::LampView::full;
+      mapper.ceiling(t, detected[i]);
     }
-    for (const auto& d : detected[i]) out.lamps_seen_whole += d.view == vision::LampView::full;
-    mapper.ceiling(t, detected[i]);
+  };
+  const std::vector<std::optional<Pose2>> carried_to =
+      place_parts(log, source, robot, o, starts, feed, frames, out.notes);
+  LampMapper mapper(robot, o.mapper);
+  for (std::size_t p = 0; p < parts; ++p) {
+    if (p > 0 && !carried_to[p]) continue;
+    if (p > 0) mapper.carried(*carried_to[p]);
+    feed(mapper, starts[p], starts[p + 1], true);
   }
   out.mapped = mapper.finish();
   out.slam_seconds = since(t1);

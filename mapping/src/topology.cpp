@@ -418,8 +418,10 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
   for (std::size_t i = 0; i < nodes.size(); ++i) left_out += dropped[i];
   if (left_out)
     rep.notes.push_back(std::to_string(left_out) +
-                        " places were left out: their regions would overlap others (the drive "
-                        "met them at an angle)");
+                        (left_out == 1
+                             ? " place was left out: its region would overlap others"
+                             : " places were left out: their regions would overlap others") +
+                        " (the drive met them at an angle)");
 
   // A drive all in one hall has no way between places, which a map must have (Nav2 loads no
   // graph without an edge): the hall is cut in two across its longest extent, the halves linked.

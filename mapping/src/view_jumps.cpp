@@ -26,9 +26,9 @@ bool has_counterpart(const LampDetection& d, const std::vector<LampDetection>& o
 
 }  // namespace
 
-std::optional<std::size_t> first_view_jump(const std::vector<ViewFrame>& frames,
-                                           const CameraDescription& cam, double semi_axis,
-                                           const ViewJumpOptions& o) {
+std::vector<std::size_t> view_jumps(const std::vector<ViewFrame>& frames,
+                                    const CameraDescription& cam, double semi_axis,
+                                    const ViewJumpOptions& o) {
   // The frames with lamps, in order.
   std::vector<std::size_t> lit;
   for (std::size_t i = 0; i < frames.size(); ++i)
@@ -50,13 +50,14 @@ std::optional<std::size_t> first_view_jump(const std::vector<ViewFrame>& frames,
         return true;  // and a whole lamp is well inside that was nowhere near before
     return false;
   };
+  std::vector<std::size_t> out;
   for (std::size_t k = 1; k + 1 < lit.size(); ++k) {
     if (!jumped(lit[k - 1], lit[k])) continue;
     // The new view holds in the next frame with lamps: not one bad frame.
     if (!jumped(lit[k - 1], lit[k + 1])) continue;
-    return lit[k];
+    out.push_back(lit[k]);
   }
-  return std::nullopt;
+  return out;
 }
 
 }  // namespace lampnav::mapping

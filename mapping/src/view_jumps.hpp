@@ -1,10 +1,10 @@
 #pragma once
 // Where a drive's ceiling view jumps as no driving could make it: the robot lifted and put down
-// elsewhere (a kidnap), which the wheels do not see. Private to mapping/: a map build keeps the
-// drive up to the first jump, since the lamps after it would be placed where the wheels say the
-// robot still is.
+// elsewhere (a kidnap), which the wheels do not see. Private to mapping/: a map build maps the
+// parts between jumps apart, since the lamps after a jump would be placed where the wheels say
+// the robot still is, and joins a part to the map only where its lamps fit one place
+// (part_placement.hpp).
 
-#include <optional>
 #include <vector>
 
 #include "lampnav/core/robot_description.hpp"
@@ -27,13 +27,13 @@ struct ViewFrame {
   const std::vector<vision::LampDetection>* lamps = nullptr;  // nullptr: unreadable
 };
 
-// The index of the first frame after a jump, or nullopt. A jump: between two frames with lamps
+// The index of the first frame after each jump, in order. A jump: between two frames with lamps
 // (frames without any are passed over), every lamp of the earlier one, whole or cut by the
 // border, is gone from where the wheels' motion could have taken it; a whole lamp well inside
 // the later one was nowhere near in the earlier one (a lamp does not appear in the middle of the
 // view by driving); and the next frame with lamps still shows the new view.
-std::optional<std::size_t> first_view_jump(const std::vector<ViewFrame>& frames,
-                                           const CameraDescription& camera, double semi_axis,
-                                           const ViewJumpOptions& options = {});
+std::vector<std::size_t> view_jumps(const std::vector<ViewFrame>& frames,
+                                    const CameraDescription& camera, double semi_axis,
+                                    const ViewJumpOptions& options = {});
 
 }  // namespace lampnav::mapping

@@ -59,7 +59,11 @@ struct LampMapperOptions {
   // A lamp seen again after 20 m away joins its landmark (closing the loop). Off: it starts a
   // new one, as mapping without loop closure would (for comparison: docs/mapping.md).
   bool close_loops = true;
-  void validate() const;  // throws InputError naming the field
+  // A carry's keyframe is held where its part of the drive was placed, within these, until the
+  // lamps both parts saw tie it to the rest (`LampMapper::carried`).
+  double carry_sigma_m = 0.1;
+  double carry_sigma_yaw = 0.03;  // rad
+  void validate() const;          // throws InputError naming the field
 };
 
 // A lamp of the built map, in the map frame (the drive's start).
@@ -102,6 +106,10 @@ class LampMapper {
   // The lamps the detector found in a ceiling frame captured at `stamp` (at most as late as the
   // wheels' last reading). Only lamps seen whole are used.
   void ceiling(Stamp stamp, const std::vector<vision::LampDetection>& lamps);
+  // The robot was carried (lifted and put down, which the wheels do not see) to `pose`, in the
+  // map frame: the next frame is a keyframe there, with no odometry from the one before and
+  // nothing followed across the image from it; its lamps join landmarks as after a loop.
+  void carried(const Pose2& pose);
   // Solves a last time, merges and drops landmarks, and gives the map's lamps and the drive.
   MappingResult finish();
 
