@@ -137,9 +137,6 @@ double scale_for_distances(const graph::TopologicalMap& map, const MapBuildOptio
   return s;
 }
 
-// Where each part of a drive after a carry starts in the map (the first part's frame): each part
-// mapped on its own, then put onto the lamps of the parts before it where they fit one place
-// only. nullopt for the first part and for a part left out; a note for the user on each carry.
 // The omni camera's lamps in each of the log's omni frames (none without an omni camera).
 std::vector<OmniView> omni_views(const io::MissionLog& log, const std::string& source,
                                  const RobotDescription& robot) {
@@ -167,6 +164,9 @@ std::vector<OmniView> omni_views(const io::MissionLog& log, const std::string& s
   return out;
 }
 
+// Where each part of a drive after a carry starts in the map (the first part's frame): each part
+// mapped on its own, then put onto the lamps of the parts before it where they fit one place
+// only. nullopt for the first part and for a part left out; a note for the user on each carry.
 template <class Feed>
 std::vector<std::optional<Pose2>> place_parts(
     const io::MissionLog& log, const std::string& source, const RobotDescription& robot,
@@ -210,7 +210,9 @@ std::vector<std::optional<Pose2>> place_parts(
     Placement placed = place_part({&lamps, &path}, {&part.lamps, &part.keyframes}, po);
     std::string told;  // how the omni camera told places alike apart
     const CameraDescription* omni_camera = robot.find_camera("omni_camera");
-    if (placed.fitting > 1 && omni_camera) {
+    if (placed.fitting > OmniChoiceOptions{}.max_candidates && omni_camera) {
+      told = " (too many for the omni camera's views to be tried)";
+    } else if (placed.fitting > 1 && omni_camera) {
       if (!omni) omni = omni_views(log, source, robot);
       // The map so far holds the parts placed before this one: their views count as well.
       std::vector<const OmniView*> before;
@@ -238,7 +240,7 @@ std::vector<std::optional<Pose2>> place_parts(
       }
       told = c.views > 0 ? buf : "";
     }
-    char head[200], tail[400];
+    char head[200], tail[640];
     std::snprintf(head, sizeof head,
                   "the ceiling view jumped %.1f s into the drive as no driving could make it (the "
                   "robot was carried): the drive after it, to %.1f s,",
