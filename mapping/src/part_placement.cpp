@@ -47,12 +47,12 @@ class PointGrid {
 
  private:
   long cell_of(double v) const { return static_cast<long>(std::floor(v / cell_)); }
-  static std::int64_t key(long x, long y) {
-    return (static_cast<std::int64_t>(x) << 32) ^ static_cast<std::uint32_t>(y);
+  static std::uint64_t key(long x, long y) {
+    return (static_cast<std::uint64_t>(x) << 32) ^ static_cast<std::uint32_t>(y);
   }
   std::vector<Vector2d> points_;
   double cell_;
-  std::unordered_map<std::int64_t, std::vector<std::size_t>> cells_;
+  std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells_;
 };
 
 std::vector<Vector2d> positions(const std::vector<MappedLamp>& lamps) {
