@@ -191,6 +191,7 @@ std::vector<std::optional<Pose2>> place_parts(
     po.sure_per_height = 0.5 * half / c.pinhole.fx;
     po.camera_height_m = c.mount.xyz.z();
   }
+  const CameraDescription* omni_camera = robot.find_camera("omni_camera");
   std::optional<std::vector<OmniView>> omni;  // detected when first needed
   // The omni views taken while the frames [from, to) were.
   auto views_during = [&](std::size_t from, std::size_t to) {
@@ -209,7 +210,6 @@ std::vector<std::optional<Pose2>> place_parts(
     const MappingResult& part = alone[p];
     Placement placed = place_part({&lamps, &path}, {&part.lamps, &part.keyframes}, po);
     std::string told;  // how the omni camera told places alike apart
-    const CameraDescription* omni_camera = robot.find_camera("omni_camera");
     if (placed.fitting > OmniChoiceOptions{}.max_candidates && omni_camera) {
       told = " (too many for the omni camera's views to be tried)";
     } else if (placed.fitting > 1 && omni_camera) {

@@ -21,7 +21,7 @@ namespace lampnav::mapping {
 
 struct PlacementOptions {
   // A lamp this close to one of the other is the same lamp: once the motion is fitted to the
-  // lamps they share (the maps place lamps within a few centimetres; a junction's lamp is 15 cm
+  // lamps they share (the maps place lamps within a few centimetres; a junction's lamp is 12.5 cm
   // nearer its neighbours than a row's are to each other), and while candidates are sought.
   double match_m = 0.1;
   double seek_m = 0.25;
@@ -31,7 +31,7 @@ struct PlacementOptions {
   double axis_tolerance = 0.17;      // rad (10 deg), a rectangular lamp's axis in both maps
   // A lamp was surely mapped by a drive that passed within this of it (horizontally), per metre
   // it hangs above the ceiling camera (half the tangent of the camera's narrower half-angle:
-  // 0.24 on maps/robots/pioneer.json, 0.58 m under the office's lamps), and at least sure_m:
+  // 0.239 on maps/robots/pioneer.json, 0.57 m under the office's lamps), and at least sure_m:
   double sure_per_height = 0.2;
   double camera_height_m = 0.3;
   double sure_m = 0.5;
