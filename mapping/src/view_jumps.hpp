@@ -14,10 +14,11 @@
 namespace lampnav::mapping {
 
 struct ViewJumpOptions {
-  double margin = 0.15;       // of the image size: a lamp this far inside cannot leave in one frame
-  double gate = 0.05;         // normalized: a lamp's centre moves at most this between frames, plus
-  double min_height_m = 1.0;  // the travel over this (lamps at least this far above the camera)
-                              // plus the turn times the lamp's distance from the axis (+ 0.3)
+  double margin =
+      0.15;            // of the image size: a whole lamp this far inside cannot leave in one frame
+  double gate = 0.05;  // normalized: a lamp's centre is measured this far off its predicted place
+  double enter = 0.1;  // normalized: a lamp entering the view is first seen by this far in, at most
+  double min_height_m = 1.0;  // the lamps are at least this far above the camera
 };
 
 // One ceiling frame: when, the wheels' cumulative travel then, and what the detector found.
@@ -29,9 +30,10 @@ struct ViewFrame {
 
 // The index of the first frame after each jump, in order. A jump: between two frames with lamps
 // (frames without any are passed over), every lamp of the earlier one, whole or cut by the
-// border, is gone from where the wheels' motion could have taken it; a whole lamp well inside
-// the later one was nowhere near in the earlier one (a lamp does not appear in the middle of the
-// view by driving); and the next frame with lamps still shows the new view.
+// border, is gone from where the wheels' motion could have taken it; a lamp of the later one
+// reaches further into the view than it could have entered since, and came from no lamp of the
+// earlier one (a lamp does not appear in the middle of the view by driving); and the next frame
+// with lamps still shows the new view.
 std::vector<std::size_t> view_jumps(const std::vector<ViewFrame>& frames,
                                     const CameraDescription& camera, double semi_axis,
                                     const ViewJumpOptions& options = {});

@@ -1,6 +1,7 @@
 // Where a drive's ceiling view jumps (the robot carried): found where a lamp appears in the middle
-// of the view with none of the lamps before still in it, and nowhere else: not while driving under
-// lamps, not for one bad frame, not for a lamp that goes out or comes on.
+// of the view, or cut by the border further in than it could have entered, with none of the lamps
+// before still in it; and nowhere else: not while driving under lamps or turning on the spot, not
+// for one bad frame, not for a lamp that goes out or comes on.
 
 #include "view_jumps.hpp"
 
@@ -26,14 +27,17 @@ vision::LampDetection lamp(double x, double y, vision::LampView view = vision::L
   return d;
 }
 
-// A drive at 0.5 m/s, frames at 10 Hz, the lamps of each frame given.
+// A drive at 0.5 m/s, frames at 10 Hz, the lamps of each frame given; or turning on the spot,
+// each wheel `spin` m a frame.
 struct Drive {
   std::vector<std::vector<vision::LampDetection>> lamps;
+  double spin = 0;
   std::vector<ViewFrame> frames() const {
     std::vector<ViewFrame> out(lamps.size());
     for (std::size_t i = 0; i < lamps.size(); ++i) {
       out[i].stamp = stamp_from_seconds(0.1 * i);
-      out[i].left = out[i].right = 0.05 * i;
+      out[i].left = spin > 0 ? -spin * i : 0.05 * i;
+      out[i].right = spin > 0 ? spin * i : 0.05 * i;
       out[i].lamps = &lamps[i];
     }
     return out;
@@ -70,6 +74,39 @@ TEST(ViewJumps, ALampInTheMiddleWhereNoneWasComingIsAJump) {
   for (int i = 0; i < 20; ++i) d.lamps.push_back({lamp(-0.1 + 0.02 * i, 0.01)});
   for (int i = 0; i < 20; ++i) d.lamps.push_back({lamp(0.1 - 0.02 * i, -0.2)});
   EXPECT_EQ(view_jumps(d.frames(), camera(), 0.2), (std::vector<std::size_t>{60, 80}));
+}
+
+// Put down where the only lamp in view is cut by the border: it reaches 100 px in (a third of
+// the normalized plane), where no lamp entering since the last frame could be.
+TEST(ViewJumps, ALampCutByTheBorderFurtherInThanItCouldHaveComeIsAJump) {
+  Drive d = under_a_row_of_lamps(60);
+  for (int i = 0; i < 20; ++i) {
+    vision::LampDetection cut = lamp(-0.45 - 0.02 * i, 0.15, vision::LampView::completed);
+    cut.bbox = {0, 150, 100 - 6 * i, 175};
+    d.lamps.push_back({cut});
+  }
+  EXPECT_EQ(view_jumps(d.frames(), camera(), 0.2), (std::vector<std::size_t>{60}));
+}
+
+// Turning on the spot at 1.5 rad/s: the ceiling turns about the view's centre, and lamps far out
+// move 0.07 a frame, more than the gate. The turn is predicted (the camera is 0.1 m ahead of the
+// axis, the lamps 2.4 m above it): no jump.
+TEST(ViewJumps, TurningOnTheSpotIsNoJump) {
+  Drive d;
+  d.spin = 0.03;  // m a frame each wheel, 0.15 rad a frame on a 0.2 m semi-axis
+  const Eigen::Vector2d mount(0.1, 0.0);
+  for (int i = 0; i < 60; ++i) {
+    const double t = -0.15 * i, c = std::cos(t), s = std::sin(t);
+    std::vector<vision::LampDetection> f;
+    for (const Eigen::Vector2d& p : {Eigen::Vector2d(0.45, 0.1), Eigen::Vector2d(-0.2, -0.4)}) {
+      // The ceiling point p (normalized, at the start) seen after turning by -t.
+      const Eigen::Vector2d q = p + mount / 2.4;
+      const Eigen::Vector2d r(c * q.x() - s * q.y(), s * q.x() + c * q.y());
+      f.push_back(lamp(r.x() - mount.x() / 2.4, r.y() - mount.y() / 2.4));
+    }
+    d.lamps.push_back(f);
+  }
+  EXPECT_TRUE(view_jumps(d.frames(), camera(), 0.2).empty());
 }
 
 TEST(ViewJumps, OneBadFrameOrALampGoingOutOrComingOnIsNoJump) {
