@@ -13,6 +13,19 @@
 
 namespace lampnav::mapping {
 
+graph::Lamp MappedLamp::as_map_lamp(LampId id, const Pose2& motion) const {
+  graph::Lamp out;
+  out.id = std::move(id);
+  out.xyz = xyz;
+  out.xyz.head<2>() = motion.transform_from(xyz.head<2>());
+  out.shape = shape;
+  out.length = length;
+  out.width = width;
+  out.yaw = wrap_angle(yaw + motion.yaw());
+  out.yaw_given = shape == graph::LampShape::rectangle;
+  return out;
+}
+
 using Eigen::Vector2d;
 using Eigen::Vector3d;
 

@@ -210,7 +210,7 @@ std::vector<std::optional<Pose2>> place_parts(
     const MappingResult& part = alone[p];
     Placement placed = place_part({&lamps, &path}, {&part.lamps, &part.keyframes}, po);
     std::string told;  // how the omni camera told places alike apart
-    if (placed.fitting > OmniChoiceOptions{}.max_candidates && omni_camera) {
+    if (placed.fitting > 1 && omni_camera && !OmniChoiceOptions{}.tries(placed.fits.size())) {
       told = " (too many for the omni camera's views to be tried)";
     } else if (placed.fitting > 1 && omni_camera) {
       if (!omni) omni = omni_views(log, source, robot);

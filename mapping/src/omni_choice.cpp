@@ -12,18 +12,7 @@ namespace lampnav::mapping {
 
 namespace {
 
-graph::Lamp lamp_of(const MappedLamp& l, const Pose2& motion, std::size_t k) {
-  graph::Lamp out;
-  out.id = LampId("L" + std::to_string(k + 1));
-  out.xyz = l.xyz;
-  out.xyz.head<2>() = motion.transform_from(l.xyz.head<2>());
-  out.shape = l.shape;
-  out.length = l.length;
-  out.width = l.width;
-  out.yaw = wrap_angle(l.yaw + motion.yaw());
-  out.yaw_given = l.shape == graph::LampShape::rectangle;
-  return out;
-}
+LampId lamp_name(std::size_t k) { return LampId("L" + std::to_string(k + 1)); }
 
 // The two parts' lamps as one map, the part put where `motion` says; a part's lamp on one of the
 // map's (within `same_m`) is that lamp.
@@ -34,10 +23,10 @@ graph::TopologicalMap joined(const DrivePart& map, const DrivePart& part, const 
   node.name = "joined";
   node.place = graph::Place::hall;
   for (const MappedLamp& l : *map.lamps)
-    node.lamps.push_back(lamp_of(l, Pose2::identity(), node.lamps.size()));
+    node.lamps.push_back(l.as_map_lamp(lamp_name(node.lamps.size())));
   const std::size_t from_map = node.lamps.size();
   for (const MappedLamp& l : *part.lamps) {
-    graph::Lamp g = lamp_of(l, motion, node.lamps.size());
+    graph::Lamp g = l.as_map_lamp(lamp_name(node.lamps.size()), motion);
     bool same = false;
     for (std::size_t i = 0; i < from_map && !same; ++i)
       same = (node.lamps[i].xyz.head<2>() - g.xyz.head<2>()).norm() < same_m;
@@ -81,7 +70,7 @@ OmniChoice choose_by_omni(const DrivePart& map, const DrivePart& part,
                           const std::vector<const OmniView*>& part_views,
                           const CameraDescription& omni_camera, const OmniChoiceOptions& o) {
   OmniChoice out;
-  if (candidates.size() < 2 || static_cast<int>(candidates.size()) > o.max_candidates) return out;
+  if (!o.tries(candidates.size())) return out;
   const auto before = posed(map_views, *map.keyframes, o.max_views);
   const auto after = posed(part_views, *part.keyframes, o.max_views);
   out.views = static_cast<int>(before.size() + after.size());

@@ -36,6 +36,11 @@ struct OmniChoiceOptions {
   double gap_sigmas = 3;
   int max_views = 60;       // of each part, spread over it
   int max_candidates = 64;  // more alike than this: not tried
+
+  // Whether the views are asked to choose among this many places alike.
+  bool tries(std::size_t candidates) const {
+    return candidates >= 2 && candidates <= static_cast<std::size_t>(max_candidates);
+  }
 };
 
 struct OmniChoice {

@@ -483,15 +483,7 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
       });
     }
     for (const MappedLamp* l : ls) {
-      graph::Lamp lamp;
-      lamp.id = LampId(n.name + "-L" + std::to_string(n.lamps.size() + 1));
-      lamp.xyz = l->xyz;
-      lamp.shape = l->shape;
-      lamp.length = l->length;
-      lamp.width = l->width;
-      lamp.yaw = l->yaw;
-      lamp.yaw_given = l->shape == graph::LampShape::rectangle;
-      n.lamps.push_back(lamp);
+      n.lamps.push_back(l->as_map_lamp(LampId(n.name + "-L" + std::to_string(n.lamps.size() + 1))));
     }
   }
   for (std::size_t i = 0; i < nodes.size(); ++i)

@@ -73,6 +73,9 @@ struct MappedLamp {
   graph::LampShape shape = graph::LampShape::rectangle;
   double length = 0, width = 0;  // m, the median of the sightings' sizes
   int sightings = 0;             // keyframes that saw it
+
+  // As a lamp of a map, named `id`, moved by `motion` (from the drive's frame into another).
+  graph::Lamp as_map_lamp(LampId id, const Pose2& motion = Pose2::identity()) const;
 };
 
 struct KeyframePose {
