@@ -1,8 +1,10 @@
 #include "view_jumps.hpp"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
+#include "lampnav/fusion/ekf.hpp"
 #include "lampnav/vision/camera_models.hpp"
 
 namespace lampnav::mapping {
@@ -35,11 +37,10 @@ class ViewMotion {
       corner_ = std::max(corner_, c.norm());
   }
 
-  // Between the frames the robot went `ds` m (signed) and turned `turn` rad.
-  void set(double ds, double turn) {
-    turn_ = turn;
-    const Vector2d move(ds * std::cos(turn / 2), ds * std::sin(turn / 2));
-    shift_ = rotated(rotated(mount_ - move, -turn) - mount_, -yaw_) / o_.min_height_m;
+  // Between the frames the wheels moved the robot by `step` (x, y, yaw in its frame before).
+  void set(const fusion::StateVector& step) {
+    turn_ = step.z();
+    shift_ = rotated(rotated(mount_ - step.head<2>(), -turn_) - mount_, -yaw_) / o_.min_height_m;
     reach_ = o_.gate + shift_.norm();
   }
 
@@ -69,10 +70,7 @@ class ViewMotion {
 
  private:
   Vector2d at(double u, double v) const { return model_.normalized_of_pixel({u, v}); }
-  static Vector2d rotated(const Vector2d& p, double a) {
-    const double c = std::cos(a), s = std::sin(a);
-    return {c * p.x() - s * p.y(), s * p.x() + c * p.y()};
-  }
+  static Vector2d rotated(const Vector2d& p, double a) { return Eigen::Rotation2Dd(a) * p; }
   // Whether `later` lies where `earlier` goes, within the gate. Between two views of a lamp cut
   // by the border, its centre (the visible part's, or the completed shape's) moves by up to half
   // the part one view shows and the other does not, which shows in their lengths and widths.
@@ -108,14 +106,14 @@ std::vector<std::size_t> view_jumps(const std::vector<ViewFrame>& frames,
     if (frames[i].lamps && !frames[i].lamps->empty()) lit.push_back(i);
   ViewMotion motion(cam, o);
   auto jumped = [&](std::size_t a, std::size_t b) {
-    const double dl = frames[b].left - frames[a].left, dr = frames[b].right - frames[a].right;
-    motion.set((dl + dr) / 2, semi_axis > 0 ? (dr - dl) / (2 * semi_axis) : 0.0);
+    motion.set(fusion::predict_motion(fusion::StateVector::Zero(), frames[b].left - frames[a].left,
+                                      frames[b].right - frames[a].right, semi_axis));
     const auto& before = *frames[a].lamps;
     const auto& after = *frames[b].lamps;
     for (const LampDetection& d : before)
       if (motion.has_counterpart(d, after, true)) return false;  // a lamp stayed in view
     for (const LampDetection& d : after)
-      if (motion.could_not_have_entered(d) && !motion.has_counterpart(d, before, false))
+      if (!motion.has_counterpart(d, before, false) && motion.could_not_have_entered(d))
         return true;  // and a lamp is where it could not have come from
     return false;
   };

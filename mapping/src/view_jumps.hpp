@@ -14,9 +14,8 @@
 namespace lampnav::mapping {
 
 struct ViewJumpOptions {
-  double margin =
-      0.15;            // of the image size: a whole lamp this far inside cannot leave in one frame
-  double gate = 0.05;  // normalized: a lamp's centre is measured this far off its predicted place
+  double margin = 0.15;  // of the image size: a whole lamp this far in cannot leave in a frame
+  double gate = 0.05;    // normalized: a lamp's centre is measured this far off its predicted place
   double enter = 0.1;  // normalized: a lamp entering the view is first seen by this far in, at most
   double min_height_m = 1.0;  // the lamps are at least this far above the camera
 };
