@@ -99,7 +99,7 @@ TEST(ShapeFit, SameRectangleAsTheFitSummedPointByPoint) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> unit(0, 1);
   const double px = 1.0 / 300;  // one pixel in normalized units at fx = 300
-  std::vector<char> scratch;
+  FitScratch scratch;
   int fitted = 0, refused = 0;
   for (int trial = 0; trial < 400; ++trial) {
     const double a = (40 + 60 * unit(rng)) * px, b = a * (0.2 + 0.3 * unit(rng));

@@ -123,7 +123,7 @@ struct LampDetector::Impl {
   detail::RunMask mask_runs, opened_runs;
   detail::RunOpening opening;
   detail::EdgePoints edges;
-  std::vector<char> fit_use;  // fit_shape: which edge points are still in the fit
+  detail::FitScratch fit_scratch;  // fit_shape's
 
   Impl(const CameraDescription& camera, const LampShapePrior& p, const LampDetectorOptions& opt)
       : model(camera), prior(p), o(opt), w(camera.width), h(camera.height) {
@@ -575,7 +575,7 @@ bool LampDetector::Impl::complete(const detail::Blob& c, const ImageView& g, int
   detail::ShapeFit best;
   for (const Vector2d& start : {from_end, from_side, from_both, centroid}) {
     const detail::ShapeFit f = detail::fit_shape(edges, prior.rectangle, half_a, half_b, start,
-                                                 out.orientation, 2 * px, fit_use);
+                                                 out.orientation, 2 * px, fit_scratch);
     if (f.ok && (!best.ok || f.rms < best.rms)) best = f;
     if (best.ok && best.rms < 0.5 * px) break;  // edges fit to noise level: no other start needed
   }

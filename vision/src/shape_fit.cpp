@@ -61,36 +61,74 @@ ShapeFit fitted(ShapeFit fit, const Vector2d& c, double theta) {
 }
 
 ShapeFit fit_rectangle(const EdgePoints& pts, double a, double b, Vector2d c, double theta,
-                       double min_drop, std::vector<char>& cls) {
+                       double min_drop, FitScratch& scratch) {
   ShapeFit fit;
   // Moments about the first centre, where the points are: small numbers, no cancellation.
   const Vector2d origin = c;
   std::array<PointMoments, kClasses> m{};
+  std::vector<char>& cls = scratch.part;
   cls.assign(pts.size(), dropped);
   double rms = 0;
   bool dropping = false;  // gauss_newton_step's
+  // A point's part (and whether it is dropped: |r| > max(min_drop, 3 rms) >= min_drop) depends on
+  // the signs of q_x, q_y, |r_x| - |r_y| and min_drop - |r|. Moving the shape from (c0, theta0) to
+  // (c, theta) moves q = R^T (p - c) by at most |c - c0| + |theta - theta0| |p - c0|, which
+  // changes each of those by at most twice that. So after a pass over every point at (c0,
+  // theta0), a point whose margin there (the least of |q_x| or |q_y|, ||r_x| - |r_y|| / 2 and
+  // min_drop - |r|) is at least `far` keeps its part until the shape has moved by `far`: only the
+  // others (`near`: by a corner, or near being dropped) are looked at until then.
+  const double far = 0.5 * min_drop;
+  std::vector<int>& near = scratch.near;
+  Vector2d c0 = c;
+  double theta0 = theta, reach = 0;  // reach: max |p - c0| over the points in the fit
   for (int it = 0; it < 20; ++it) {
     const bool first = it == 0;  // every point is classed; after, only changes are moved
     const double cs = std::cos(theta), sn = std::sin(theta);
     const double drop = dropping ? std::max(min_drop, 3.0 * rms) : HUGE_VAL;
+    // A little short of `far`, for rounding.
+    const bool all =
+        first || (c - c0).norm() + std::fabs(theta - theta0) * reach >= far * (1 - 1e-6);
     // Through local pointers: the classes are bytes, and a byte store could alias anything, so
     // the compiler would read the vectors' bounds again after each one.
     const Vector2d* const pt = pts.data();
     char* const cl = cls.data();
-    const std::size_t count = pts.size();
     const double cx = c.x(), cy = c.y();
-    for (std::size_t i = 0; i < count; ++i) {
-      const Class was = static_cast<Class>(cl[i]);
-      if (!first && was == dropped) continue;  // once dropped, a point stays dropped
+    // Point i, of part `was` before: its part now, moved between the moments; its margin.
+    const auto look = [&](std::size_t i, Class was, double& margin) {
       const double dx = pt[i].x() - cx, dy = pt[i].y() - cy;
+      const double qx = cs * dx + sn * dy, qy = -sn * dx + cs * dy;
       double r;
-      Class k = classify(cs * dx + sn * dy, -sn * dx + cs * dy, a, b, r);
+      Class k = classify(qx, qy, a, b, r);
+      margin =
+          std::min({k < side_pos ? std::fabs(qx) : std::fabs(qy),
+                    0.5 * std::fabs(std::fabs(std::fabs(qx) - a) - std::fabs(std::fabs(qy) - b)),
+                    min_drop - std::fabs(r)});
       if (std::fabs(r) > drop) k = dropped;
-      if (!first && k == was) continue;
+      if (!first && k == was) return k;
       const Vector2d p = pt[i] - origin;
       if (!first) m[was].add(p, -1.0);
       if (k != dropped) m[k].add(p, 1.0);
       cl[i] = k;
+      return k;
+    };
+    double margin;
+    if (all) {
+      c0 = c;
+      theta0 = theta;
+      near.clear();
+      double reach2 = 0;
+      const std::size_t count = pts.size();
+      for (std::size_t i = 0; i < count; ++i) {
+        const Class was = static_cast<Class>(cl[i]);
+        if (!first && was == dropped) continue;  // once dropped, a point stays dropped
+        if (look(i, was, margin) == dropped) continue;
+        if (margin < far) near.push_back(static_cast<int>(i));
+        reach2 = std::max(reach2, (pt[i] - c0).squaredNorm());
+      }
+      reach = std::sqrt(reach2);
+    } else {
+      for (const int i : near)
+        if (cl[i] != dropped) look(static_cast<std::size_t>(i), static_cast<Class>(cl[i]), margin);
     }
     // Per class: T = sum (p - d) and P = sum (p - d)(p - d)^T, d = c - origin; then the sums of
     // q_x, q_y and their products follow from e = (cos, sin) and f = (-sin, cos).
@@ -151,9 +189,9 @@ ShapeFit fit_rectangle(const EdgePoints& pts, double a, double b, Vector2d c, do
 }  // namespace
 
 ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Vector2d c,
-                   double theta, double min_drop, std::vector<char>& scratch) {
+                   double theta, double min_drop, FitScratch& scratch) {
   if (rectangle) return fit_rectangle(pts, a, b, c, theta, min_drop, scratch);
-  std::vector<char>& use = scratch;  // 1 while a point is in the fit
+  std::vector<char>& use = scratch.part;  // 1 while a point is in the fit
   // A disc: its distance to a point needs the point's own square root, so it is summed point by
   // point. Its heading is pinned (unit information, zero gradient) and the same 3x3 solved.
   ShapeFit fit;

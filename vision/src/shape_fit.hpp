@@ -18,14 +18,22 @@ struct ShapeFit {
   bool ok = false;
 };
 
+// The fit's state per point, kept by the caller from call to call (no allocation once the sizes
+// have settled).
+struct FitScratch {
+  std::vector<char> part;  // each point: in the fit (on which part of the shape) or dropped
+  std::vector<int> near;   // a rectangle's points whose part a small move of the shape could change
+};
+
 // Gauss-Newton fit of a rectangle (half sizes a >= b, normalized units) or a disc (radius a) of
 // known size to edge points, from one initial centre `c` and heading `theta`. Once the fit has
 // settled on every point (or after three iterations), points more than max(min_drop, 3 rms) from
-// the shape are dropped (fringe, corners), and it goes on until it settles again. `scratch` holds
-// each point's state (in the fit, on which part of the shape, or dropped), kept by the caller from
-// call to call. A rectangle's sums come from moments of its points kept per part of the shape, so
-// an iteration costs a pass that finds the points that changed part, not a sum over all of them.
+// the shape are dropped (fringe, corners), and it goes on until it settles again. A rectangle's
+// sums come from moments of its points kept per part of the shape, so an iteration only has to
+// find the points that changed part; and it looks only at the points near a change (by a corner,
+// or near being dropped), as long as the shape has moved less than their margin since they were
+// all looked at. The result is the same as looking at every point every time.
 ShapeFit fit_shape(const EdgePoints& pts, bool rectangle, double a, double b, Eigen::Vector2d c,
-                   double theta, double min_drop, std::vector<char>& scratch);
+                   double theta, double min_drop, FitScratch& scratch);
 
 }  // namespace lampnav::vision::detail
