@@ -14,32 +14,6 @@ void RunMask::reset(int width, int height) {
 
 namespace {
 
-// Along rows: a pixel k in [r, w - r) is set after erosion when all of k - r .. k + r are, after
-// dilation when any is; the pixels nearer the edge are cleared.
-void along_rows(const RunMask& in, int r, bool erode, RunMask& out) {
-  const int w = in.width();
-  out.reset(w, in.height());
-  for (int y = 0; y < in.height(); ++y) {
-    out.begin_row();
-    bool open = false;
-    Span cur;
-    for (const Span* s = in.row_begin(y); s != in.row_end(y); ++s) {
-      const int a = erode ? s->a + r : std::max(s->a - r, r);
-      const int b = erode ? s->b - r : std::min(s->b + r, w - 1 - r);
-      if (a > b) continue;
-      if (open && a <= cur.b + 1) {  // dilated spans that touch become one
-        cur.b = std::max(cur.b, b);
-        continue;
-      }
-      if (open) out.add(cur.a, cur.b);
-      cur = {a, b};
-      open = true;
-    }
-    if (open) out.add(cur.a, cur.b);
-  }
-  out.end_rows();
-}
-
 // x = x AND row (sorted, disjoint spans).
 void intersect(std::vector<Span>& x, const Span* first, const Span* last, std::vector<Span>& tmp) {
   tmp.clear();
@@ -92,57 +66,6 @@ class SortedSpans {
   int n_ = 0;
 };
 
-// Rows y0..y1 (inclusive) hold at most one span each; `empty` is set when one holds none.
-bool single_spans(const RunMask& in, int y0, int y1, bool& empty) {
-  empty = false;
-  for (int j = y0; j <= y1; ++j) {
-    const auto n = in.row_end(j) - in.row_begin(j);
-    if (n > 1) return false;
-    empty |= n == 0;
-  }
-  return true;
-}
-
-// Along columns: row y in [r, h - r) is the AND (erosion) or OR (dilation) of rows y - r .. y + r;
-// the rows nearer the edge are empty.
-void along_columns(const RunMask& in, int r, bool erode, RunMask& out, std::vector<Span>& x,
-                   std::vector<Span>& tmp) {
-  const int h = in.height();
-  out.reset(in.width(), h);
-  for (int y = 0; y < h; ++y) {
-    out.begin_row();
-    if (y < r || y >= h - r) continue;
-    // The common case, a convex blob (and the empty rows of its margin): at most one span in each
-    // of the 2r + 1 rows, joined directly.
-    bool empty = false;
-    if (2 * r + 1 <= kMaxDirect && single_spans(in, y - r, y + r, empty)) {
-      if (erode) {
-        if (empty) continue;
-        int a = in.row_begin(y - r)->a, b = in.row_begin(y - r)->b;
-        for (int j = y - r + 1; j <= y + r; ++j)
-          a = std::max(a, in.row_begin(j)->a), b = std::min(b, in.row_begin(j)->b);
-        if (a <= b) out.add(a, b);
-        continue;
-      }
-      SortedSpans sorted;
-      for (int j = y - r; j <= y + r; ++j)
-        if (in.row_begin(j) != in.row_end(j)) sorted.insert(*in.row_begin(j));
-      sorted.add_joined_to(out);
-      continue;
-    }
-    x.assign(in.row_begin(y - r), in.row_end(y - r));
-    if (erode) {
-      for (int j = y - r + 1; j <= y + r && !x.empty(); ++j)
-        intersect(x, in.row_begin(j), in.row_end(j), tmp);
-    } else {
-      for (int j = y - r + 1; j <= y + r; ++j) x.insert(x.end(), in.row_begin(j), in.row_end(j));
-      std::sort(x.begin(), x.end(), [](const Span& s, const Span& t) { return s.a < t.a; });
-    }
-    add_joined(x.data(), x.data() + x.size(), out);  // only a union has spans to join
-  }
-  out.end_rows();
-}
-
 }  // namespace
 
 bool RunOpening::open_single_spans(const RunMask& in, int r, RunMask& out) {
@@ -161,14 +84,14 @@ bool RunOpening::open_single_spans(const RunMask& in, int r, RunMask& out) {
   // Along columns: row y's span is the intersection of rows y - r .. y + r (empty as soon as one
   // is), for y in [r, h - r); then grown by r along the row, kept off the r pixels at either end.
   // An eroded span lies in [r, w - 1 - r], so growing and clipping it cannot empty it.
-  grown_.assign(static_cast<std::size_t>(h), Span{1, 0});
+  grown_rows_.assign(static_cast<std::size_t>(h), Span{1, 0});
   for (int y = r; y < h - r; ++y) {
     int a = 0, b = w - 1;
     for (int j = y - r; j <= y + r && a <= b; ++j) {
       a = std::max(a, eroded_rows_[j].a);
       b = std::min(b, eroded_rows_[j].b);
     }
-    if (a <= b) grown_[y] = {std::max(a - r, r), std::min(b + r, w - 1 - r)};
+    if (a <= b) grown_rows_[y] = {std::max(a - r, r), std::min(b + r, w - 1 - r)};
   }
   // Dilation along columns: row y is the union of the grown spans of rows y - r .. y + r. When
   // every two of them overlap or touch (the usual case: a lamp's rows), it is one span from the
@@ -179,7 +102,7 @@ bool RunOpening::open_single_spans(const RunMask& in, int r, RunMask& out) {
     if (y < r || y >= h - r) continue;
     int n = 0, lo = w, hi = -1, last_start = -1, first_end = w;
     for (int j = y - r; j <= y + r; ++j) {
-      const Span s = grown_[j];
+      const Span s = grown_rows_[j];
       if (s.a > s.b) continue;
       ++n;
       lo = std::min(lo, s.a), hi = std::max(hi, s.b);
@@ -192,19 +115,91 @@ bool RunOpening::open_single_spans(const RunMask& in, int r, RunMask& out) {
     }
     SortedSpans sorted;
     for (int j = y - r; j <= y + r; ++j)
-      if (grown_[j].a <= grown_[j].b) sorted.insert(grown_[j]);
+      if (grown_rows_[j].a <= grown_rows_[j].b) sorted.insert(grown_rows_[j]);
     sorted.add_joined_to(out);
   }
   out.end_rows();
   return true;
 }
 
+void RunOpening::open_general(const RunMask& in, int r, RunMask& out) {
+  const int w = in.width(), h = in.height();
+  // Erosion along rows: each span shrunk by r at both ends. A lamp's fringe (spans of 2r pixels
+  // or fewer beside it) is gone after it.
+  eroded_.reset(w, h);
+  for (int y = 0; y < h; ++y) {
+    eroded_.begin_row();
+    for (const Span* s = in.row_begin(y); s != in.row_end(y); ++s)
+      if (s->b - s->a >= 2 * r) eroded_.add(s->a + r, s->b - r);
+  }
+  eroded_.end_rows();
+  // Erosion along columns, then dilation along rows: row y in [r, h - r) is the intersection of
+  // the eroded rows y - r .. y + r (empty as soon as one is), each of its spans grown by r and
+  // kept off the r pixels at either end of the row, those that then touch joined. The usual case
+  // (a lamp's rows, and its ragged first and last rows once eroded) is one span in each of those
+  // rows: their intersection is from the greatest start to the least end. An eroded span lies in
+  // [r, w - 1 - r], so growing and clipping it cannot empty it.
+  grown_.reset(w, h);
+  for (int y = 0; y < h; ++y) {
+    grown_.begin_row();
+    if (y < r || y >= h - r) continue;
+    bool single = true, empty = false;
+    for (int j = y - r; j <= y + r && !empty; ++j) {
+      const auto n = eroded_.row_end(j) - eroded_.row_begin(j);
+      empty = n == 0;
+      single &= n == 1;
+    }
+    if (empty) continue;
+    if (single) {
+      int a = 0, b = w - 1;
+      for (int j = y - r; j <= y + r; ++j)
+        a = std::max(a, eroded_.row_begin(j)->a), b = std::min(b, eroded_.row_begin(j)->b);
+      if (a <= b) grown_.add(std::max(a - r, r), std::min(b + r, w - 1 - r));
+      continue;
+    }
+    a_.assign(eroded_.row_begin(y - r), eroded_.row_end(y - r));
+    for (int j = y - r + 1; j <= y + r && !a_.empty(); ++j)
+      intersect(a_, eroded_.row_begin(j), eroded_.row_end(j), b_);
+    for (Span& s : a_) s = {std::max(s.a - r, r), std::min(s.b + r, w - 1 - r)};
+    add_joined(a_.data(), a_.data() + a_.size(), grown_);
+  }
+  grown_.end_rows();
+  // Dilation along columns: row y is the union of the grown rows y - r .. y + r. When each holds
+  // at most one span and every two of them overlap or touch, it is one span from the least start
+  // to the greatest end; otherwise they are sorted and joined.
+  out.reset(w, h);
+  for (int y = 0; y < h; ++y) {
+    out.begin_row();
+    if (y < r || y >= h - r) continue;
+    int n = 0, lo = w, hi = -1, last_start = -1, first_end = w;
+    bool single = true;
+    for (int j = y - r; j <= y + r; ++j) {
+      const Span *s = grown_.row_begin(j), *end = grown_.row_end(j);
+      if (s == end) continue;
+      single &= end - s == 1;
+      ++n;
+      lo = std::min(lo, s->a), hi = std::max(hi, s->b);
+      last_start = std::max(last_start, s->a), first_end = std::min(first_end, s->b);
+    }
+    if (n == 0) continue;
+    if (single && last_start <= first_end + 1) {
+      out.add(lo, hi);
+      continue;
+    }
+    a_.clear();
+    for (int j = y - r; j <= y + r; ++j)
+      a_.insert(a_.end(), grown_.row_begin(j), grown_.row_end(j));
+    // A handful of spans: sorted by insertion.
+    for (std::size_t i = 1; i < a_.size(); ++i)
+      for (std::size_t k = i; k > 0 && a_[k - 1].a > a_[k].a; --k) std::swap(a_[k - 1], a_[k]);
+    add_joined(a_.data(), a_.data() + a_.size(), out);
+  }
+  out.end_rows();
+}
+
 void RunOpening::open(const RunMask& in, int r, RunMask& out) {
   if (r <= kMaxSingleSpanRadius && open_single_spans(in, r, out)) return;
-  along_rows(in, r, true, rows_);
-  along_columns(rows_, r, true, eroded_, a_, b_);
-  along_rows(eroded_, r, false, dilated_rows_);
-  along_columns(dilated_rows_, r, false, out, a_, b_);
+  open_general(in, r, out);
 }
 
 }  // namespace lampnav::vision::detail

@@ -31,9 +31,10 @@ class RunMask {
   std::vector<int> start_;
 };
 
-// Opening (erosion, then dilation) by a (2r+1)^2 square, separably along rows then columns, with
-// the pixels within r of the mask's own edge counted as outside (the caller pads the mask by more
-// than r). The same pixels as the byte-wise opening; scratch kept from call to call.
+// Opening (erosion, then dilation) by a (2r+1)^2 square, separably (erosion along rows, then
+// columns; dilation along rows, then columns), with the pixels within r of the mask's own edge
+// counted as outside (the caller pads the mask by more than r). The same pixels as the byte-wise
+// opening; scratch kept from call to call.
 class RunOpening {
  public:
   void open(const RunMask& in, int r, RunMask& out);
@@ -43,9 +44,12 @@ class RunOpening {
   // without a fringe): the erosion along columns and the dilation are then done on two ints a
   // row, without intermediate masks. False, `out` untouched, for any other mask.
   bool open_single_spans(const RunMask& in, int r, RunMask& out);
-  RunMask rows_, eroded_, dilated_rows_;
+  // Any mask (a lamp's ragged first or last row leaves several spans after the erosion along
+  // rows), in three passes over the rows.
+  void open_general(const RunMask& in, int r, RunMask& out);
+  RunMask eroded_, grown_;  // open_general: eroded along rows; then along columns, grown along rows
   std::vector<Span> a_, b_;
-  std::vector<Span> eroded_rows_, grown_;  // open_single_spans: a span a row, a > b when none
+  std::vector<Span> eroded_rows_, grown_rows_;  // open_single_spans: a span a row, a > b when none
 };
 
 }  // namespace lampnav::vision::detail
