@@ -73,10 +73,11 @@ ShapeFit fit_rectangle(const EdgePoints& pts, double a, double b, Vector2d c, do
   // A point's part (and whether it is dropped: |r| > max(min_drop, 3 rms) >= min_drop) depends on
   // the signs of q_x, q_y, |r_x| - |r_y| and min_drop - |r|. Moving the shape from (c0, theta0) to
   // (c, theta) moves q = R^T (p - c) by at most |c - c0| + |theta - theta0| |p - c0|, which
-  // changes each of those by at most twice that. So after a pass over every point at (c0,
-  // theta0), a point whose margin there (the least of |q_x| or |q_y|, ||r_x| - |r_y|| / 2 and
-  // min_drop - |r|) is at least `far` keeps its part until the shape has moved by `far`: only the
-  // others (`near`: by a corner, or near being dropped) are looked at until then.
+  // changes q_x, q_y and min_drop - |r| by at most that, and |r_x| - |r_y| by at most twice that.
+  // So after a pass over every point at (c0, theta0), a point whose margin there (the least of
+  // |q_x| or |q_y|, ||r_x| - |r_y|| / 2 and min_drop - |r|) is at least `far` keeps its part
+  // until the shape has moved by `far`: only the others (`near`: by a corner, or near being
+  // dropped) are looked at until then.
   const double far = 0.5 * min_drop;
   std::vector<int>& near = scratch.near;
   Vector2d c0 = c;
