@@ -189,9 +189,7 @@ void RunOpening::open_general(const RunMask& in, int r, RunMask& out) {
     a_.clear();
     for (int j = y - r; j <= y + r; ++j)
       a_.insert(a_.end(), grown_.row_begin(j), grown_.row_end(j));
-    // A handful of spans: sorted by insertion.
-    for (std::size_t i = 1; i < a_.size(); ++i)
-      for (std::size_t k = i; k > 0 && a_[k - 1].a > a_[k].a; --k) std::swap(a_[k - 1], a_[k]);
+    std::sort(a_.begin(), a_.end(), [](const Span& s, const Span& t) { return s.a < t.a; });
     add_joined(a_.data(), a_.data() + a_.size(), out);
   }
   out.end_rows();
