@@ -164,16 +164,19 @@ std::vector<OmniView> omni_views(const io::MissionLog& log, const std::string& s
   return out;
 }
 
-// Where each part of a drive after a carry starts in the map (the first part's frame): each part
-// mapped on its own, then put onto the lamps of the parts before it where they fit one place
-// only. nullopt for the first part and for a part left out; a note for the user on each carry.
+// Where each part of a drive after a carry starts in the map (the frame of the base: the first
+// part that maps a lamp): each part mapped on its own, then put onto the lamps of the parts
+// before it where they fit one place only. nullopt for the base, for the parts before it and for
+// a part left out; a note for the user on each carry.
 template <class Feed>
 std::vector<std::optional<Pose2>> place_parts(
     const io::MissionLog& log, const std::string& source, const RobotDescription& robot,
     const MapBuildOptions& o, const std::vector<std::size_t>& starts, Feed& feed,
-    const std::vector<const io::Logged<io::ImageFrame>*>& frames, std::vector<std::string>& notes) {
+    const std::vector<const io::Logged<io::ImageFrame>*>& frames, std::vector<std::string>& notes,
+    std::size_t& base) {
   const std::size_t parts = starts.size() - 1;
   std::vector<std::optional<Pose2>> out(parts);
+  base = 0;
   std::vector<MappingResult> alone;
   for (std::size_t p = 0; p < parts && parts > 1; ++p) {
     LampMapper mapper(robot, o.mapper);
@@ -201,12 +204,22 @@ std::vector<std::optional<Pose2>> place_parts(
         during.push_back(&v);
     return during;
   };
-  std::vector<MappedLamp> lamps = alone[0].lamps;
-  std::vector<KeyframePose> path = alone[0].keyframes;
   auto seconds = [&](std::size_t i) {
     return to_seconds(frames[i]->value.stamp - frames.front()->value.stamp);
   };
-  for (std::size_t p = 1; p < parts; ++p) {
+  while (base + 1 < parts && alone[base].lamps.empty()) ++base;
+  if (base > 0) {
+    char buf[240];
+    std::snprintf(buf, sizeof buf,
+                  "the ceiling view jumped %.1f s into the drive as no driving could make it (the "
+                  "robot was carried); the drive before it mapped no lamp, so the map starts "
+                  "where the robot was put down",
+                  seconds(starts[base]));
+    notes.push_back(buf);
+  }
+  std::vector<MappedLamp> lamps = alone[base].lamps;
+  std::vector<KeyframePose> path = alone[base].keyframes;
+  for (std::size_t p = base + 1; p < parts; ++p) {
     const MappingResult& part = alone[p];
     Placement placed = place_part({&lamps, &path}, {&part.lamps, &part.keyframes}, po);
     std::string told;  // how the omni camera told places alike apart
@@ -216,8 +229,8 @@ std::vector<std::optional<Pose2>> place_parts(
       if (!omni) omni = omni_views(log, source, robot);
       // The map so far holds the parts placed before this one: their views count as well.
       std::vector<const OmniView*> before;
-      for (std::size_t q = 0; q < p; ++q)
-        if (q == 0 || out[q]) {
+      for (std::size_t q = base; q < p; ++q)
+        if (q == base || out[q]) {
           const auto v = views_during(starts[q], starts[q + 1]);
           before.insert(before.end(), v.begin(), v.end());
         }
@@ -376,14 +389,20 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
   // the map of the drive before it only where its lamps fit one place.
   std::vector<std::size_t> starts{0};
   {
+    // The wheels' travel at each frame, between the readings on either side of it.
     std::vector<ViewFrame> view(frames.size());
     std::size_t w = 0;
     for (std::size_t i = 0; i < frames.size(); ++i) {
-      view[i].stamp = frames[i]->value.stamp;
-      for (; w + 1 < wheels.size() && wheels[w + 1].value.stamp <= view[i].stamp; ++w) {
+      const Stamp t = frames[i]->value.stamp;
+      view[i].stamp = t;
+      for (; w + 1 < wheels.size() && wheels[w + 1].value.stamp <= t; ++w) {
       }
-      view[i].left = wheels[w].value.left;
-      view[i].right = wheels[w].value.right;
+      const auto& a = wheels[w].value;
+      const auto& b = wheels[std::min(w + 1, wheels.size() - 1)].value;
+      const double span = to_seconds(b.stamp - a.stamp);
+      const double f = span > 0 ? std::clamp(to_seconds(t - a.stamp) / span, 0.0, 1.0) : 0.0;
+      view[i].left = a.left + f * (b.left - a.left);
+      view[i].right = a.right + f * (b.right - a.right);
       view[i].lamps = unreadable[i] ? nullptr : &detected[i];
     }
     for (const std::size_t jump : view_jumps(view, *cam, robot.semi_axis)) starts.push_back(jump);
@@ -408,17 +427,22 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
       mapper.ceiling(t, detected[i]);
     }
   };
+  std::size_t base = 0;
   const std::vector<std::optional<Pose2>> carried_to =
-      place_parts(log, source, robot, o, starts, feed, frames, out.notes);
+      place_parts(log, source, robot, o, starts, feed, frames, out.notes, base);
   LampMapper mapper(robot, o.mapper);
-  for (std::size_t p = 0; p < parts; ++p) {
-    if (p > 0 && !carried_to[p]) continue;
-    if (p > 0) mapper.carried(*carried_to[p]);
+  for (std::size_t p = base; p < parts; ++p) {
+    if (p > base && !carried_to[p]) continue;
+    if (p > base) mapper.carried(*carried_to[p]);
     feed(mapper, starts[p], starts[p + 1], true);
   }
   out.mapped = mapper.finish();
   out.slam_seconds = since(t1);
-  if (o.start) {
+  if (o.start && base > 0) {
+    out.notes.push_back(
+        "--start is where the drive started, which is not in the map: the map's frame is where "
+        "the robot was put down");
+  } else if (o.start) {
     // The whole drive and its lamps moved so that the start is where the user says.
     const Pose2& T = *o.start;
     for (auto& l : out.mapped.lamps) {
