@@ -308,10 +308,25 @@ std::vector<std::size_t> moved_places(const std::vector<std::vector<Sighting>>& 
       for (std::size_t q = p[i - 1].k + 1; q <= k; ++q) least[q] = std::min(least[q], d);
     }
   }
-  // A jump is where `least` peaks above `moved`: its neighbours mix views of both sides.
+  // The line: `moved`, or more on a bumpier floor, where the drive's own lamps wander further.
+  // The floor's wander is measured away from the moves over `moved` (a carry's, and its
+  // neighbours', which mix views of both sides).
+  std::vector<char> near(least.size(), 0);
+  for (std::size_t k = 0; k < least.size(); ++k)
+    if (least[k] != HUGE_VAL && least[k] > o.moved)
+      for (std::size_t q = k > span ? k - span : 0; q < std::min(least.size(), k + span + 1); ++q)
+        near[q] = 1;
+  std::vector<double> moves;
+  for (std::size_t k = 0; k < least.size(); ++k)
+    if (least[k] != HUGE_VAL && !near[k]) moves.push_back(least[k]);
+  if (moves.empty()) moves.push_back(0);
+  const auto p90 = moves.begin() + moves.size() * 9 / 10;
+  std::nth_element(moves.begin(), p90, moves.end());
+  const double line = std::max(o.moved, o.moved_over_p90 * *p90);
+  // A jump is where `least` peaks above the line: its neighbours mix views of both sides.
   std::vector<std::size_t> out;
   for (std::size_t k = 1; k < least.size(); ++k) {
-    if (least[k] == HUGE_VAL || least[k] <= o.moved) continue;
+    if (least[k] == HUGE_VAL || least[k] <= line) continue;
     bool peak = true;
     for (std::size_t q = k > span ? k - span : 0; q < std::min(least.size(), k + span + 1); ++q)
       if (least[q] != HUGE_VAL && (least[q] > least[k] || (least[q] == least[k] && q < k)))
