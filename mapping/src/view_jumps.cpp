@@ -179,7 +179,8 @@ std::vector<std::vector<Sighting>> follow_lamps(const std::vector<ViewFrame>& fr
                                                 const std::vector<fusion::StateVector>& poses,
                                                 const CameraDescription& cam,
                                                 const ViewJumpOptions& o, ViewMotion& motion,
-                                                std::vector<std::vector<Place>>& places) {
+                                                std::vector<std::vector<Place>>& places,
+                                                std::vector<double>* residuals) {
   std::vector<std::vector<Sighting>> out(lit.size());
   std::vector<HeightFit> fits;
   double lowest = HUGE_VAL, highest = 0;  // m, the heights told so far
@@ -195,14 +196,18 @@ std::vector<std::vector<Sighting>> follow_lamps(const std::vector<ViewFrame>& fr
       Sighting& s = out[k][j];
       s.d = &lamps[j];
       double best = o.gate;
+      const Sighting* from = nullptr;
       if (k > 0)
         for (const Sighting& e : out[k - 1]) {
           const double x = motion.excess(e, lamps[j]);
           if (x <= best) {
             best = x;
-            s.track = e.track;
+            from = &e;
           }
         }
+      if (from) s.track = from->track;
+      if (residuals && from && from->height > 0 && whole(*from->d) && whole(lamps[j]))
+        residuals->push_back(best + o.gate);
       if (s.track < 0) {
         s.track = static_cast<int>(fits.size());
         fits.emplace_back();
@@ -345,11 +350,25 @@ std::vector<std::size_t> view_jumps(const std::vector<ViewFrame>& frames,
   std::vector<std::size_t> lit;
   for (std::size_t i = 0; i < frames.size(); ++i)
     if (frames[i].lamps && !frames[i].lamps->empty()) lit.push_back(i);
-  ViewMotion motion(cam, o);
   const std::vector<fusion::StateVector> poses = wheel_poses(frames, semi_axis);
+  // The gate, wider on a bumpier floor: where the drive's whole lamps of known height lie off
+  // their predicted places further than on the office's floor.
+  ViewJumpOptions g = o;
+  {
+    ViewMotion probe(cam, o);
+    std::vector<std::vector<Place>> unused;
+    std::vector<double> off;
+    follow_lamps(frames, lit, poses, cam, o, probe, unused, &off);
+    if (off.size() >= 100) {
+      const auto p99 = off.begin() + off.size() * 99 / 100;
+      std::nth_element(off.begin(), p99, off.end());
+      g.gate = std::max(o.gate, o.gate_over_p99 * *p99);
+    }
+  }
+  ViewMotion motion(cam, g);
   std::vector<std::vector<Place>> places;
   const std::vector<std::vector<Sighting>> seen =
-      follow_lamps(frames, lit, poses, cam, o, motion, places);
+      follow_lamps(frames, lit, poses, cam, g, motion, places, nullptr);
   std::vector<std::size_t> out;
   for (std::size_t k = 1; k + 1 < lit.size(); ++k) {
     motion.set(step(poses[lit[k - 1]], poses[lit[k]]));
@@ -369,7 +388,7 @@ std::vector<std::size_t> view_jumps(const std::vector<ViewFrame>& frames,
   // A lamp's place moving where the view jumped as well is the same jump, seen a frame or two
   // off (the views averaged on its sides mix the two).
   const std::size_t pairs = out.size();
-  for (const std::size_t k : moved_places(seen, places, o)) {
+  for (const std::size_t k : moved_places(seen, places, g)) {
     bool same = false;
     for (std::size_t q = 0; q < pairs; ++q) {
       const auto at =

@@ -16,6 +16,10 @@ namespace lampnav::mapping {
 struct ViewJumpOptions {
   double margin = 0.15;  // of the image size: a whole lamp this far in cannot leave in a frame
   double gate = 0.05;    // normalized: a lamp's centre is measured this far off its predicted place
+  // ... or this many times the 99th percentile of how far the drive's whole lamps of known height
+  // lie off their predicted places, if more (floor bumps of 0.5 deg: 0.040 to 0.044; 0.7 deg:
+  // 0.062 to 0.064; 1 deg: 0.082 to 0.093).
+  double gate_over_p99 = 1.1;
   double enter = 0.1;  // normalized: a lamp entering the view is first seen by this far in, at most
   double min_height_m = 1.0;  // the lamps are at least this far above the camera
   // A lamp's place by the wheels from one whole view, 1 sigma, over its height above the camera

@@ -147,6 +147,19 @@ TEST(ViewJumps, ALampCutByTheBorderInBothViewsDoesNotHoldTheViewTogether) {
   EXPECT_EQ(view_jumps(d.frames(), camera(), 0.2), (std::vector<std::size_t>{40}));
 }
 
+// A bumpy floor: two frames in every ten swing the view 0.07 sideways, more than the gate. The
+// drive's lamps of known height then lie off their predicted places by that much in a fifth of
+// their views, and the gate widens to take it: no jump, but the carry at frame 300.
+TEST(ViewJumps, ABumpyFloorWidensTheGate) {
+  Drive d = under_a_row_of_lamps(300);
+  for (int i = 0; i < 50; ++i) d.lamps.push_back({lamp(0.2 - 0.02 * i, -0.25)});
+  for (int i = 0; i < 350; ++i)
+    if (i % 10 == 3 || i % 10 == 4)
+      for (vision::LampDetection& l : d.lamps[i])
+        l = lamp(l.centre.x(), l.centre.y() + 0.07, l.view);
+  EXPECT_EQ(view_jumps(d.frames(), camera(), 0.2), (std::vector<std::size_t>{300}));
+}
+
 TEST(ViewJumps, OneBadFrameOrALampGoingOutOrComingOnIsNoJump) {
   Drive glitch = under_a_row_of_lamps(120);
   glitch.lamps[60] = {lamp(0.05, 0.2)};  // one frame: a reflection, the lamps missed
