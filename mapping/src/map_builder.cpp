@@ -9,6 +9,7 @@
 #include "drive_scale.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/core/parallel.hpp"
+#include "lampnav/fusion/odometry_track.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "median.hpp"
@@ -389,23 +390,19 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
   // the map of the drive before it only where its lamps fit one place.
   std::vector<std::size_t> starts{0};
   {
-    // The wheels' travel at each frame, between the readings on either side of it.
+    // The robot's pose by its wheels at each frame, between the readings on either side of it.
+    fusion::OdometryTrack dead_reckoned(robot.semi_axis, Duration::max());
+    for (std::size_t w = 0; w < wheels.size(); ++w)
+      dead_reckoned.add(wheels[w].value.stamp,
+                        w > 0 ? wheels[w].value.left - wheels[w - 1].value.left : 0.0,
+                        w > 0 ? wheels[w].value.right - wheels[w - 1].value.right : 0.0);
     std::vector<ViewFrame> view(frames.size());
-    std::size_t w = 0;
     for (std::size_t i = 0; i < frames.size(); ++i) {
-      const Stamp t = frames[i]->value.stamp;
-      view[i].stamp = t;
-      for (; w + 1 < wheels.size() && wheels[w + 1].value.stamp <= t; ++w) {
-      }
-      const auto& a = wheels[w].value;
-      const auto& b = wheels[std::min(w + 1, wheels.size() - 1)].value;
-      const double span = to_seconds(b.stamp - a.stamp);
-      const double f = span > 0 ? std::clamp(to_seconds(t - a.stamp) / span, 0.0, 1.0) : 0.0;
-      view[i].left = a.left + f * (b.left - a.left);
-      view[i].right = a.right + f * (b.right - a.right);
+      view[i].stamp = frames[i]->value.stamp;
+      view[i].wheels = dead_reckoned.at(view[i].stamp);
       view[i].lamps = unreadable[i] ? nullptr : &detected[i];
     }
-    for (const std::size_t jump : view_jumps(view, *cam, robot.semi_axis)) starts.push_back(jump);
+    for (const std::size_t jump : view_jumps(view, *cam)) starts.push_back(jump);
   }
   const std::size_t parts = starts.size();
   starts.push_back(frames.size());

@@ -4,8 +4,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "lampnav/core/pose2.hpp"
-#include "lampnav/fusion/ekf.hpp"
 #include "lampnav/vision/camera_models.hpp"
 
 namespace lampnav::mapping {
@@ -51,10 +49,10 @@ class ViewMotion {
       corner_ = std::max(corner_, c.norm());
   }
 
-  // Between the frames the wheels moved the robot by `step` (x, y, yaw in its frame before).
-  void set(const fusion::StateVector& step) {
-    turn_ = step.z();
-    move_ = rotated(rotated(mount_ - step.head<2>(), -turn_) - mount_, -yaw_);
+  // Between the frames the wheels moved the robot by `step` (in its frame before).
+  void set(const Pose2& step) {
+    turn_ = step.yaw();
+    move_ = rotated(rotated(mount_ - step.translation(), -turn_) - mount_, -yaw_);
     reach_ = o_.gate + move_.norm() / o_.min_height_m;
   }
 
@@ -151,24 +149,6 @@ struct HeightFit {
   }
 };
 
-// The robot's pose at each frame by the wheels alone (x, y, yaw; the first frame at zero).
-std::vector<fusion::StateVector> wheel_poses(const std::vector<ViewFrame>& frames,
-                                             double semi_axis) {
-  std::vector<fusion::StateVector> out(frames.size(), fusion::StateVector::Zero());
-  for (std::size_t i = 1; i < frames.size(); ++i)
-    out[i] = fusion::predict_motion(out[i - 1], frames[i].left - frames[i - 1].left,
-                                    frames[i].right - frames[i - 1].right, semi_axis);
-  return out;
-}
-
-// The robot's motion from pose a to pose b, in its frame at a.
-fusion::StateVector step(const fusion::StateVector& a, const fusion::StateVector& b) {
-  fusion::StateVector out;
-  out.head<2>() = Eigen::Rotation2Dd(-a.z()) * (b.head<2>() - a.head<2>());
-  out.z() = wrap_angle(b.z() - a.z());
-  return out;
-}
-
 // The lamps of the frames with lamps (lit), each followed from the frame with lamps before it:
 // it takes the track of the lamp it lies nearest to where the wheels take it, within twice the
 // gate (a frame bumped off by more than the gate keeps its track), else a new one. Its inverse
@@ -176,7 +156,6 @@ fusion::StateVector step(const fusion::StateVector& a, const fusion::StateVector
 // views.
 std::vector<std::vector<Sighting>> follow_lamps(const std::vector<ViewFrame>& frames,
                                                 const std::vector<std::size_t>& lit,
-                                                const std::vector<fusion::StateVector>& poses,
                                                 const CameraDescription& cam,
                                                 const ViewJumpOptions& o, ViewMotion& motion,
                                                 std::vector<std::vector<Place>>& places,
@@ -189,9 +168,9 @@ std::vector<std::vector<Sighting>> follow_lamps(const std::vector<ViewFrame>& fr
   for (std::size_t k = 0; k < lit.size(); ++k) {
     const auto& lamps = *frames[lit[k]].lamps;
     out[k].resize(lamps.size());
-    if (k > 0) motion.set(step(poses[lit[k - 1]], poses[lit[k]]));
-    const fusion::StateVector& p = poses[lit[k]];
-    const Eigen::Rotation2Dd turn(p.z());
+    if (k > 0) motion.set(frames[lit[k - 1]].wheels.between(frames[lit[k]].wheels));
+    const Pose2& p = frames[lit[k]].wheels;
+    const Eigen::Rotation2Dd turn(p.yaw());
     for (std::size_t j = 0; j < lamps.size(); ++j) {
       Sighting& s = out[k][j];
       s.d = &lamps[j];
@@ -215,7 +194,7 @@ std::vector<std::vector<Sighting>> follow_lamps(const std::vector<ViewFrame>& fr
       }
       HeightFit& fit = fits[s.track];
       if (whole(lamps[j])) {
-        const Place place{k, p.head<2>() + turn * mount, turn * (mount_yaw * lamps[j].centre)};
+        const Place place{k, p.translation() + turn * mount, turn * (mount_yaw * lamps[j].centre)};
         fit.add(place.a, place.b);
         places[s.track].push_back(place);
       }
@@ -344,43 +323,40 @@ std::vector<std::size_t> moved_places(const std::vector<std::vector<Sighting>>& 
 }  // namespace
 
 std::vector<std::size_t> view_jumps(const std::vector<ViewFrame>& frames,
-                                    const CameraDescription& cam, double semi_axis,
-                                    const ViewJumpOptions& o) {
+                                    const CameraDescription& cam, const ViewJumpOptions& o) {
   // The frames with lamps, in order.
   std::vector<std::size_t> lit;
   for (std::size_t i = 0; i < frames.size(); ++i)
     if (frames[i].lamps && !frames[i].lamps->empty()) lit.push_back(i);
-  const std::vector<fusion::StateVector> poses = wheel_poses(frames, semi_axis);
   // The gate, wider on a bumpier floor: where the drive's whole lamps of known height lie off
-  // their predicted places further than on the office's floor.
+  // their predicted places further than on the office's floor. Then the lamps are followed again
+  // with it (`motion` reads the gate from `g`).
   ViewJumpOptions g = o;
-  {
-    ViewMotion probe(cam, o);
-    std::vector<std::vector<Place>> unused;
-    std::vector<double> off;
-    follow_lamps(frames, lit, poses, cam, o, probe, unused, &off);
-    if (off.size() >= 100) {
-      const auto p99 = off.begin() + off.size() * 99 / 100;
-      std::nth_element(off.begin(), p99, off.end());
-      g.gate = std::max(o.gate, o.gate_over_p99 * *p99);
-    }
-  }
   ViewMotion motion(cam, g);
   std::vector<std::vector<Place>> places;
-  const std::vector<std::vector<Sighting>> seen =
-      follow_lamps(frames, lit, poses, cam, g, motion, places, nullptr);
+  std::vector<double> off;
+  std::vector<std::vector<Sighting>> seen = follow_lamps(frames, lit, cam, g, motion, places, &off);
+  if (off.size() >= 100) {
+    const auto p99 = off.begin() + off.size() * 99 / 100;
+    std::nth_element(off.begin(), p99, off.end());
+    g.gate = std::max(o.gate, o.gate_over_p99 * *p99);
+  }
+  if (g.gate > o.gate) {
+    places.clear();
+    seen = follow_lamps(frames, lit, cam, g, motion, places, nullptr);
+  }
   std::vector<std::size_t> out;
   for (std::size_t k = 1; k + 1 < lit.size(); ++k) {
-    motion.set(step(poses[lit[k - 1]], poses[lit[k]]));
+    motion.set(frames[lit[k - 1]].wheels.between(frames[lit[k]].wheels));
     if (!jumped(seen[k - 1], seen[k], motion)) continue;
     // The new view holds in the next frame with lamps: not one bad frame.
-    motion.set(step(poses[lit[k - 1]], poses[lit[k + 1]]));
+    motion.set(frames[lit[k - 1]].wheels.between(frames[lit[k + 1]].wheels));
     if (!jumped(seen[k - 1], seen[k + 1], motion)) continue;
     // And from the frame with lamps before: not one bad frame before it either.
     if (k >= 2) {
-      motion.set(step(poses[lit[k - 2]], poses[lit[k]]));
+      motion.set(frames[lit[k - 2]].wheels.between(frames[lit[k]].wheels));
       if (!jumped(seen[k - 2], seen[k], motion)) continue;
-      motion.set(step(poses[lit[k - 2]], poses[lit[k + 1]]));
+      motion.set(frames[lit[k - 2]].wheels.between(frames[lit[k + 1]].wheels));
       if (!jumped(seen[k - 2], seen[k + 1], motion)) continue;
     }
     out.push_back(lit[k]);

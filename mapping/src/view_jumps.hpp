@@ -7,6 +7,7 @@
 
 #include <vector>
 
+#include "lampnav/core/pose2.hpp"
 #include "lampnav/core/robot_description.hpp"
 #include "lampnav/core/time.hpp"
 #include "lampnav/vision/lamp_detector.hpp"
@@ -36,10 +37,11 @@ struct ViewJumpOptions {
   double moved_over_p90 = 3;
 };
 
-// One ceiling frame: when, the wheels' cumulative travel then, and what the detector found.
+// One ceiling frame: when, the robot's pose then by its wheels alone (dead reckoning in any fixed
+// frame, fusion::OdometryTrack's), and what the detector found.
 struct ViewFrame {
   Stamp stamp;
-  double left = 0, right = 0;                                 // m
+  Pose2 wheels;
   const std::vector<vision::LampDetection>* lamps = nullptr;  // nullptr: unreadable
 };
 
@@ -59,7 +61,7 @@ struct ViewFrame {
 //   ceiling looks nearly alike, closer than one frame's gate can tell); not within 2 x window
 //   frames with lamps of a jump of the first kind.
 std::vector<std::size_t> view_jumps(const std::vector<ViewFrame>& frames,
-                                    const CameraDescription& camera, double semi_axis,
+                                    const CameraDescription& camera,
                                     const ViewJumpOptions& options = {});
 
 }  // namespace lampnav::mapping

@@ -28,7 +28,7 @@ vision::LampDetection lamp(double x, double y, vision::LampView view = vision::L
 }
 
 // A drive at 0.5 m/s, frames at 10 Hz, the lamps of each frame given; or turning on the spot,
-// each wheel `spin` m a frame.
+// each wheel `spin` m a frame (on a 0.2 m semi-axis).
 struct Drive {
   std::vector<std::vector<vision::LampDetection>> lamps;
   double spin = 0;
@@ -37,8 +37,7 @@ struct Drive {
     std::vector<ViewFrame> out(lamps.size());
     for (std::size_t i = 0; i < lamps.size(); ++i) {
       out[i].stamp = stamp_from_seconds(0.1 * i);
-      out[i].left = spin > 0 ? -spin * i : speed * i;
-      out[i].right = spin > 0 ? spin * i : speed * i;
+      out[i].wheels = spin > 0 ? Pose2(0, 0, spin * i / 0.2) : Pose2(speed * i, 0, 0);
       out[i].lamps = &lamps[i];
     }
     return out;
@@ -65,7 +64,7 @@ Drive under_a_row_of_lamps(int frames) {
 
 TEST(ViewJumps, DrivingUnderLampsIsNoJump) {
   const Drive d = under_a_row_of_lamps(200);
-  EXPECT_TRUE(view_jumps(d.frames(), camera(), 0.2).empty());
+  EXPECT_TRUE(view_jumps(d.frames(), camera()).empty());
 }
 
 TEST(ViewJumps, ALampInTheMiddleWhereNoneWasComingIsAJump) {
@@ -74,7 +73,7 @@ TEST(ViewJumps, ALampInTheMiddleWhereNoneWasComingIsAJump) {
   // frame 80, under a lamp off to the side.
   for (int i = 0; i < 20; ++i) d.lamps.push_back({lamp(0.1 - 0.02 * i, 0.01)});
   for (int i = 0; i < 20; ++i) d.lamps.push_back({lamp(0.1 - 0.02 * i, -0.2)});
-  EXPECT_EQ(view_jumps(d.frames(), camera(), 0.2), (std::vector<std::size_t>{60, 80}));
+  EXPECT_EQ(view_jumps(d.frames(), camera()), (std::vector<std::size_t>{60, 80}));
 }
 
 // Put down where the only lamp in view is cut by the border: it reaches 100 px in (a third of
@@ -86,7 +85,7 @@ TEST(ViewJumps, ALampCutByTheBorderFurtherInThanItCouldHaveComeIsAJump) {
     cut.bbox = {0, 150, 100 - 6 * i, 175};
     d.lamps.push_back({cut});
   }
-  EXPECT_EQ(view_jumps(d.frames(), camera(), 0.2), (std::vector<std::size_t>{60}));
+  EXPECT_EQ(view_jumps(d.frames(), camera()), (std::vector<std::size_t>{60}));
 }
 
 // Turning on the spot at 1.5 rad/s: the ceiling turns about the view's centre, and lamps far out
@@ -107,7 +106,7 @@ TEST(ViewJumps, TurningOnTheSpotIsNoJump) {
     }
     d.lamps.push_back(f);
   }
-  EXPECT_TRUE(view_jumps(d.frames(), camera(), 0.2).empty());
+  EXPECT_TRUE(view_jumps(d.frames(), camera()).empty());
 }
 
 // Carried at frame 80, under a lamp seen whole since frame 62: the lamp jumps 0.08 further along
@@ -120,7 +119,7 @@ TEST(ViewJumps, ALampsHeightFromItsViewsNarrowsWhereItCanGo) {
     const Drive shifted = under_a_row_of_lamps(i + 5);
     d.lamps[i] = shifted.lamps[i + 4];  // 4 frames on: 0.08 further along
   }
-  EXPECT_EQ(view_jumps(d.frames(), camera(), 0.2), (std::vector<std::size_t>{80}));
+  EXPECT_EQ(view_jumps(d.frames(), camera()), (std::vector<std::size_t>{80}));
 }
 
 // Put down at frame 80 where the lamp lies 0.045 (11 cm) to the side of where the wheels take
@@ -131,7 +130,7 @@ TEST(ViewJumps, ALookAlikePlaceCloserThanTheGateIsFoundByTheLampsPlaces) {
   Drive d = under_a_row_of_lamps(120);
   for (int i = 80; i < 120; ++i)
     for (vision::LampDetection& l : d.lamps[i]) l = lamp(l.centre.x(), 0.045, l.view);
-  EXPECT_EQ(view_jumps(d.frames(), camera(), 0.2), (std::vector<std::size_t>{80}));
+  EXPECT_EQ(view_jumps(d.frames(), camera()), (std::vector<std::size_t>{80}));
 }
 
 // Put down where a whole lamp lies in the middle of the view, with a lamp at the border where
@@ -144,7 +143,7 @@ TEST(ViewJumps, ALampCutByTheBorderInBothViewsDoesNotHoldTheViewTogether) {
                        lamp(-0.45, 0.0, vision::LampView::completed)});
   for (int i = 0; i < 20; ++i)
     d.lamps.push_back({lamp(0.48, 0.0, vision::LampView::partial), lamp(-0.1, 0.0)});
-  EXPECT_EQ(view_jumps(d.frames(), camera(), 0.2), (std::vector<std::size_t>{40}));
+  EXPECT_EQ(view_jumps(d.frames(), camera()), (std::vector<std::size_t>{40}));
 }
 
 // A bumpy floor: two frames in every ten swing the view 0.07 sideways, more than the gate. The
@@ -157,17 +156,17 @@ TEST(ViewJumps, ABumpyFloorWidensTheGate) {
     if (i % 10 == 3 || i % 10 == 4)
       for (vision::LampDetection& l : d.lamps[i])
         l = lamp(l.centre.x(), l.centre.y() + 0.07, l.view);
-  EXPECT_EQ(view_jumps(d.frames(), camera(), 0.2), (std::vector<std::size_t>{300}));
+  EXPECT_EQ(view_jumps(d.frames(), camera()), (std::vector<std::size_t>{300}));
 }
 
 TEST(ViewJumps, OneBadFrameOrALampGoingOutOrComingOnIsNoJump) {
   Drive glitch = under_a_row_of_lamps(120);
   glitch.lamps[60] = {lamp(0.05, 0.2)};  // one frame: a reflection, the lamps missed
-  EXPECT_TRUE(view_jumps(glitch.frames(), camera(), 0.2).empty());
+  EXPECT_TRUE(view_jumps(glitch.frames(), camera()).empty());
 
   Drive out = under_a_row_of_lamps(120);
   for (int i = 60; i < 120; ++i) out.lamps[i].clear();  // the lamp overhead fails, then dark
-  EXPECT_TRUE(view_jumps(out.frames(), camera(), 0.2).empty());
+  EXPECT_TRUE(view_jumps(out.frames(), camera()).empty());
 
   Drive on = under_a_row_of_lamps(120);
   for (int i = 60; i < 120; ++i) {  // one comes on, and the drive takes it across the view
@@ -177,7 +176,7 @@ TEST(ViewJumps, OneBadFrameOrALampGoingOutOrComingOnIsNoJump) {
     else if (std::abs(x) < 0.55)
       on.lamps[i].push_back(lamp(x, 0.3, vision::LampView::completed));
   }
-  EXPECT_TRUE(view_jumps(on.frames(), camera(), 0.2).empty());
+  EXPECT_TRUE(view_jumps(on.frames(), camera()).empty());
 }
 
 }  // namespace
