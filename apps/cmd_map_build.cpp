@@ -133,12 +133,21 @@ int run_survey(const SurveyArgs& a) {
   RobotDescription robot;
   const io::MissionLog log = read_log_for_robot(a.log, a.robot, a.topics, robot);
   ProgressBar bar(a.quiet || a.json);
-  const mapping::DriveLamps drive = mapping::map_drive_lamps(
-      log, a.log, robot, {}, [&bar](double f) { bar.update(f, "mapping the drive"); });
-  bar.done();
-  for (const auto& note : drive.notes) diagnostic("note", note);
   mapping::SurveyOptions so;
   if (!a.initial_pose.empty()) so.start = parse_pose_option(a.initial_pose, "--initial-pose");
+  // Given where the drive started, the drive's lamps are kept in the frame of its start.
+  mapping::MapBuildOptions bo;
+  bo.keep_larger_part = !so.start;
+  const mapping::DriveLamps drive = mapping::map_drive_lamps(
+      log, a.log, robot, bo, [&bar](double f) { bar.update(f, "mapping the drive"); });
+  bar.done();
+  for (const auto& note : drive.notes) diagnostic("note", note);
+  if (so.start && !drive.from_start) {
+    diagnostic("note",
+               "--initial-pose is where the drive started, which is not in the drive's map (the "
+               "drive before the first carry mapped no lamp): the drive is placed by its lamps");
+    so.start.reset();
+  }
   const mapping::SurveyResult s = mapping::survey(loaded.map, drive.mapped, robot, so);
   if (!a.update.empty()) graph::save_map(s.updated, a.update);
   int failed = 0, moved = 0, added = 0;

@@ -18,6 +18,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <random>
+#include <sstream>
 
 #include <string>
 
@@ -85,12 +86,49 @@ void trace_frame(double t, const Pose2& truth, const fusion::Localizer& loc) {
   std::cerr << "\n";
   if (std::string(std::getenv("LAMPNAV_TRACE")) == "2") {
     std::cerr << "  truth " << truth << "\n";
+    // What the map's errors charged each (map_evidence.hpp): absences, misfits, spots, far.
+    auto ledgers = [](const fusion::Hypothesis& h) {
+      double lamps = 0, misfits = 0, strays = 0;
+      for (const auto& a : h.map_costs.lamps) lamps += a.second;
+      for (const auto& a : h.map_costs.misfits) misfits += a.second;
+      for (const auto& a : h.map_costs.strays) strays += a.spent;
+      std::ostringstream s;
+      s << " ledgers " << lamps << "/" << misfits << "/" << strays << "/" << h.map_costs.far_strays;
+      return s.str();
+    };
     for (std::size_t k = 0; k < std::min<std::size_t>(hs.size(), 6); ++k)
       std::cerr << "  " << hs[k].pose << " w " << hs[k].weight << " last " << hs[k].last_cost
-                << "\n";
+                << ledgers(hs[k]) << "\n";
     if (rank >= 6)
-      std::cerr << "  truth's " << hs[rank].pose << " last " << hs[rank].last_cost << "\n";
+      std::cerr << "  truth's " << hs[rank].pose << " last " << hs[rank].last_cost
+                << ledgers(hs[rank]) << "\n";
   }
+}
+
+// Episodes first_seed + 1 to first_seed + count of `episode(battery, seed)`. LAMPNAV_EPISODE=seed
+// runs that episode alone; LAMPNAV_EPISODES=1 prints each (stderr); LAMPNAV_TRACE as above.
+template <class Episode>
+test::BatteryFigures run_episodes(const graph::TopologicalMap& map, const RobotDescription& robot,
+                                  test::BatteryOptions options, std::uint64_t first_seed, int count,
+                                  Episode episode, const fusion::LocalizerOptions& localizer = {}) {
+  if (std::getenv("LAMPNAV_TRACE")) options.trace = trace_frame;
+  test::Battery battery(map, robot, options, localizer);
+  std::vector<test::EpisodeResult> rs;
+  const char* only = std::getenv("LAMPNAV_EPISODE");
+  for (int k = 1; k <= count; ++k) {
+    const std::uint64_t seed = first_seed + k;
+    if (only && std::strtoull(only, nullptr, 10) != seed) continue;
+    rs.push_back(episode(battery, seed));
+    if (only || std::getenv("LAMPNAV_EPISODES")) {
+      const test::EpisodeResult& r = rs.back();
+      std::cerr << "seed " << seed << ": detected " << r.detected << ", fixed " << r.fixed
+                << ", right " << r.fix_correct << ", wrong fixes " << r.wrong_fixes << ", after "
+                << r.latency_m << " m (oracle "
+                << (r.oracle_m ? std::to_string(*r.oracle_m) + " m" : "undecided") << ")"
+                << (r.fixed ? "" : ": " + r.last_why) << "\n";
+    }
+  }
+  return test::figures(rs);
 }
 
 // range(0) nodes, range(1) episodes, each `episode(battery, seed)`.
@@ -99,28 +137,9 @@ void run_battery(benchmark::State& state, std::uint64_t first_seed, Episode epis
                  const fusion::LocalizerOptions& localizer = {}) {
   const World w(static_cast<int>(state.range(0)));
   test::BatteryFigures f;
-  for (auto _ : state) {
-    test::BatteryOptions options;
-    if (std::getenv("LAMPNAV_TRACE")) options.trace = trace_frame;
-    test::Battery battery(w.map, w.robot, options, localizer);
-    std::vector<test::EpisodeResult> rs;
-    // LAMPNAV_EPISODE=seed runs that episode alone; LAMPNAV_EPISODES=1 prints each (stderr).
-    const char* only = std::getenv("LAMPNAV_EPISODE");
-    for (int k = 1; k <= state.range(1); ++k) {
-      const std::uint64_t seed = first_seed + k;
-      if (only && std::strtoull(only, nullptr, 10) != seed) continue;
-      rs.push_back(episode(battery, seed));
-      if (only || std::getenv("LAMPNAV_EPISODES")) {
-        const test::EpisodeResult& r = rs.back();
-        std::cerr << "seed " << seed << ": detected " << r.detected << ", fixed " << r.fixed
-                  << ", right " << r.fix_correct << ", wrong fixes " << r.wrong_fixes << ", after "
-                  << r.latency_m << " m (oracle "
-                  << (r.oracle_m ? std::to_string(*r.oracle_m) + " m" : "undecided") << ")"
-                  << (r.fixed ? "" : ": " + r.last_why) << "\n";
-      }
-    }
-    f = test::figures(rs);
-  }
+  for (auto _ : state)
+    f = run_episodes(w.map, w.robot, {}, first_seed, static_cast<int>(state.range(1)), episode,
+                     localizer);
   report(state, f);
 }
 
@@ -180,12 +199,9 @@ void BM_UnknownStartsOnAnImperfectMap(benchmark::State& state) {
   const RobotDescription robot =
       read_robot_description(std::string(LAMPNAV_SOURCE_DIR) + "/maps/robots/pioneer.json");
   test::BatteryFigures f;
-  for (auto _ : state) {
-    test::Battery battery(map, robot, options);
-    std::vector<test::EpisodeResult> rs;
-    for (int k = 1; k <= 20; ++k) rs.push_back(battery.unknown_start(9500 + k));
-    f = test::figures(rs);
-  }
+  for (auto _ : state)
+    f = run_episodes(map, robot, options, 9500, 20,
+                     [](test::Battery& b, std::uint64_t seed) { return b.unknown_start(seed); });
   report(state, f);
 }
 BENCHMARK(BM_UnknownStartsOnAnImperfectMap)

@@ -208,6 +208,7 @@ std::vector<std::optional<Pose2>> place_parts(
   auto seconds = [&](std::size_t i) {
     return to_seconds(frames[i]->value.stamp - frames.front()->value.stamp);
   };
+  const std::size_t first_note = notes.size();
   while (base + 1 < parts && alone[base].lamps.empty()) ++base;
   if (base > 0) {
     char buf[240];
@@ -253,6 +254,32 @@ std::vector<std::optional<Pose2>> place_parts(
                       c.views, c.fewest_missed, c.least_extra);
       }
       told = c.views > 0 ? buf : "";
+    }
+    if (o.keep_larger_part && !placed.motion && part.lamps.size() > lamps.size()) {
+      // A part that cannot join the map so far and maps more lamps than it becomes the base:
+      // of two maps that cannot be joined, the larger is kept. The lamp SLAM takes the parts in
+      // time order, so the drive before it is left out, not put onto it.
+      char fit[80], buf[800];
+      if (placed.fitting == 0)
+        std::snprintf(fit, sizeof fit, "fit nowhere on");
+      else
+        std::snprintf(fit, sizeof fit, "fit %d places alike of", placed.fitting);
+      std::snprintf(
+          buf, sizeof buf,
+          "the ceiling view jumped %.1f s into the drive as no driving could make it (the "
+          "robot was carried), and its %zu lamps after it, to %.1f s, %s the %zu mapped "
+          "before it%s: the map is built from the drive after it, starting where the "
+          "robot was put down, and the drive before it is left out; map that from a "
+          "drive of its own, or drive there without lifting the robot",
+          seconds(starts[p]), part.lamps.size(), seconds(starts[p + 1] - 1), fit, lamps.size(),
+          told.c_str());
+      notes.resize(first_note);
+      notes.push_back(buf);
+      std::fill(out.begin(), out.end(), std::nullopt);
+      base = p;
+      lamps = part.lamps;
+      path = part.keyframes;
+      continue;
     }
     char head[200], tail[640];
     std::snprintf(head, sizeof head,
@@ -435,6 +462,7 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
   }
   out.mapped = mapper.finish();
   out.slam_seconds = since(t1);
+  out.from_start = base == 0;
   if (o.start && base > 0) {
     out.notes.push_back(
         "--start is where the drive started, which is not in the map: the map's frame is where "

@@ -39,6 +39,10 @@ struct MapBuildOptions {
   // Where the drive started, in the frame the map should have (an existing map's, a floor plan's);
   // without it the map's frame is the start itself (x forward, y left).
   std::optional<Pose2> start;
+  // Of the parts of a drive between carries that cannot be joined, keep the one that maps the
+  // most lamps (the map's frame then starts where the robot was put down), or the first (false:
+  // its frame is the drive's start, as a survey given that start needs).
+  bool keep_larger_part = true;
   // Distances measured between lamps: the map is scaled to fit them (least squares), about the
   // drive's start; heights above the ceiling camera scale alike. Refused (InputError) when a lamp
   // is not in the map, when they ask for a scale further than `max_scale_change` from the wheels'
@@ -57,6 +61,9 @@ struct DriveLamps {
   vision::LampShapePrior prior;  // learnt: the lamps' size seen from unit distance
   std::size_t frames = 0, unreadable_frames = 0, lamps_seen_whole = 0;
   double travel_m = 0;
+  // The map's frame is the drive's start; false: where the robot was put down after a carry (the
+  // drive before it is left out).
+  bool from_start = true;
   double detect_seconds = 0;       // learning the lamps' look and detecting them in every frame
   double slam_seconds = 0;         // the lamp SLAM, solves included
   std::vector<std::string> notes;  // for the user
