@@ -11,6 +11,7 @@
 #include "lampnav/core/error.hpp"
 #include "lampnav/internal/json_util.hpp"
 #include "lampnav/io/calibration.hpp"
+#include "lampnav/vision/camera_models.hpp"
 
 namespace lampnav::apps {
 namespace {
@@ -46,10 +47,10 @@ int run_import(const ImportArgs& a) {
                        "no camera '" + name + "' to take " + from +
                            " (a calibration does not know the mount): add it, or name another "
                            "with --camera");
-    if (name == "ceiling_camera" && ic.camera.model != CameraModelKind::pinhole)
+    if (name == "ceiling_camera" && !vision::PinholeCamera::takes(ic.camera.model))
       throw InputError({path, ic.label, "distortion_model"},
-                       "the ceiling camera must be a pinhole camera (its pipeline needs one), "
-                       "this calibration is " +
+                       "the ceiling camera must be a pinhole or kannala_brandt camera (its "
+                       "pipeline needs one), this calibration is " +
                            std::string(to_string(ic.camera.model)));
     ic.camera.name = target->name;
     ic.camera.mount = target->mount;

@@ -70,4 +70,13 @@ std::optional<double> CeilingGeometry::base_direction(const Vector2d& n, double 
   return std::atan2(d.y(), d.x());
 }
 
+Eigen::Matrix2d CeilingGeometry::tilt_jacobian(const Eigen::Vector2d& n) {
+  // The point (x, y, 1) seen from a camera turned by w = (a, b, 0) is (x, y, 1) - w x (x, y, 1):
+  // to first order x' = x - b (1 + x^2) + a x y, y' = y + a (1 + y^2) - b x y.
+  const double x = n.x(), y = n.y();
+  Eigen::Matrix2d T;
+  T << x * y, -(1 + x * x), 1 + y * y, -x * y;
+  return T;
+}
+
 }  // namespace lampnav::fusion

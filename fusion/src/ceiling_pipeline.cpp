@@ -53,11 +53,23 @@ void CeilingPipelineOptions::validate() const {
 
 LampLabeller::LampLabeller(const graph::TopologicalMap& map, const CameraDescription& camera,
                            const LabellerOptions& options)
-    : map_(&map), geometry_(camera), fx_(camera.pinhole.fx), o_(options) {
+    : map_(&map), geometry_(camera), model_(camera), o_(options) {
   o_.validate();
-  if (camera.model != CameraModelKind::pinhole)
-    throw Error("the ceiling camera '" + camera.name + "' must be a pinhole camera");
   gate_ = chi_square_quantile(o_.gate_probability, 3);
+  // How far from the camera a lamp of the map can be seen: the image's farthest corner in the
+  // normalized plane (at most 3, 72 degrees off the axis), at the highest lamp, and a metre for
+  // the pose's error.
+  double corner = 0;
+  for (const Eigen::Vector2d& px :
+       {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(camera.width - 0.5, -0.5),
+        Eigen::Vector2d(-0.5, camera.height - 0.5),
+        Eigen::Vector2d(camera.width - 0.5, camera.height - 0.5)})
+    corner = std::max(corner, model_.normalized_of_pixel(px).norm());
+  double top = 0;
+  for (const auto& node : map.nodes())
+    for (const auto& l : node.lamps) top = std::max(top, l.xyz.z());
+  reach_m_ = std::min(corner, 3.0) * std::max(0.0, top - geometry_.mount_origin().z()) +
+             std::hypot(camera.mount.xyz.x(), camera.mount.xyz.y()) + 1.0;
 }
 
 std::vector<const graph::Lamp*> LampLabeller::candidates(const Pose2& predicted) const {
@@ -71,6 +83,12 @@ std::vector<const graph::Lamp*> LampLabeller::candidates(const Pose2& predicted)
   std::vector<const graph::Lamp*> out;
   for (NodeId id : nodes)
     for (const auto& l : map_->node(id).lamps) out.push_back(&l);
+  // And every lamp the camera can see from there: a wide lens at a junction sees the lamps of
+  // the corridors beyond it, two places away.
+  const std::size_t own = out.size();
+  map_->visit_lamps_within(predicted.translation(), reach_m_, [&](const graph::Lamp& l) {
+    if (std::find(out.begin(), out.begin() + own, &l) == out.begin() + own) out.push_back(&l);
+  });
   return out;
 }
 
@@ -97,7 +115,7 @@ LabelResult LampLabeller::label(const vision::LampDetection& d, const Pose2& pre
           std::abs(d.width * dz - wide) > tol * std::max(wide, 0.5 * lamp->length))
         continue;
     }
-    const double sn = o_.pixel_sigma / fx_, sm = o_.map_sigma / dz;
+    const double sm = o_.map_sigma / dz;
     // Innovation on (centre, axis). The axis turns with the heading one for one (an upward
     // camera); round lamps have no axis and are gated on the centre alone.
     const bool axis = lamp->shape == graph::LampShape::rectangle && lamp->length > lamp->width;
@@ -106,8 +124,12 @@ LabelResult LampLabeller::label(const vision::LampDetection& d, const Pose2& pre
     Vector3d nu = Vector3d::Zero();
     nu.head<2>() = d.centre - *n;
     Matrix3d R = Matrix3d::Zero();
-    R.topLeftCorner<2, 2>() =
-        (sn * sn + sm * sm + o_.tilt_sigma * o_.tilt_sigma) * Eigen::Matrix2d::Identity();
+    // A pixel spans more of the normalized plane, and a floor bump moves a lamp further, off
+    // the axis than on it (a wide lens's edge: several times).
+    const Eigen::Matrix2d T = CeilingGeometry::tilt_jacobian(*n);
+    R.topLeftCorner<2, 2>() = model_.normalized_covariance(*n, o_.pixel_sigma) +
+                              o_.tilt_sigma * o_.tilt_sigma * T * T.transpose() +
+                              sm * sm * Eigen::Matrix2d::Identity();
     if (axis) {
       const auto o = geometry_.predict_orientation(predicted, lamp->xyz, lamp->yaw);
       const Pose2 turned(predicted.x(), predicted.y(), predicted.yaw() + 1e-6);
@@ -203,6 +225,7 @@ struct CeilingPipeline::Impl {
   vision::LampTracker tracker;
   LampLabeller labeller;
   CeilingGeometry geometry;
+  vision::PinholeCamera model;
   std::map<int, const graph::Lamp*> label_of_track;
 
   // Labels a frame's lamps and measures the pose; `tracked`: a track keeps its label.
@@ -215,7 +238,8 @@ struct CeilingPipeline::Impl {
         o(opt),
         tracker(c, shape_prior_for(m, c), opt.detector, opt.tracker),
         labeller(m, c, opt.labeller),
-        geometry(c) {
+        geometry(c),
+        model(c) {
     o.validate();
   }
 };
@@ -283,8 +307,8 @@ CeilingObservation CeilingPipeline::Impl::label(Stamp stamp, const vision::Track
   }
   if (!labelled.empty()) {
     std::string why;
-    out.measurement = measure_pose(geometry, camera.pinhole.fx, labelled, predicted, stamp,
-                                   o.measurement, &why, &out.no_measurement);
+    out.measurement = measure_pose(geometry, model, labelled, predicted, stamp, o.measurement, &why,
+                                   &out.no_measurement);
     if (!out.measurement) out.no_measurement_reason = why;
   } else if (!out.lamps.empty()) {
     out.no_measurement_reason = "no labelled lamp in full view";

@@ -240,9 +240,8 @@ struct HypothesisSet::Impl {
           o.ceiling_miss_cost, o.lamp_out_cost);
     if (!labelled.empty()) {
       PoseRefusal refusal = PoseRefusal::none;
-      const std::optional<PoseMeasurement> m =
-          measure_pose(*geometry, camera->parameters().fx, labelled, h.pose, Stamp{}, measurement,
-                       nullptr, &refusal);
+      const std::optional<PoseMeasurement> m = measure_pose(
+          *geometry, *camera, labelled, h.pose, Stamp{}, measurement, nullptr, &refusal);
       // The ceiling camera places a lamp to a few millimetres, so a fit's misfit is mostly the
       // map's error (a lamp a few centimetres off), the same in every frame: counted, it made
       // one of two look-alike places certain within a second. Only a misfit past what the map's

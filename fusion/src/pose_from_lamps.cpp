@@ -44,7 +44,8 @@ struct Term {
 
 }  // namespace
 
-std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry, double fx,
+std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry,
+                                            const vision::PinholeCamera& camera,
                                             const std::vector<LabelledLamp>& lamps,
                                             const Pose2& predicted, Stamp stamp,
                                             const PoseMeasurementOptions& o, std::string* why,
@@ -61,14 +62,20 @@ std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry, dou
     const auto& d = l.detection;
     if (!l.lamp || d.view == vision::LampView::partial) continue;
     const bool completed = d.view == vision::LampView::completed;
-    const double sn = (completed ? o.completed_pixel_sigma : o.pixel_sigma) / fx;
+    const double sp = completed ? o.completed_pixel_sigma : o.pixel_sigma;
     Term t;
     Matrix2d J;
     const auto b = geometry.base_point(d.centre, l.lamp->xyz.z(), &J);
     if (!b) continue;
     t.map_xy = l.lamp->xyz.head<2>();
     t.base = *b;
-    t.base_cov = sn * sn * J * J.transpose();
+    // The centre's error in the normalized plane: the pixel's, through the lens where it is seen;
+    // and a floor bump's beyond what it moves every lamp alike (added to the fit's covariance
+    // below), which grows off the axis: a wide lens's corner lamp moves several times as far.
+    const Matrix2d T = CeilingGeometry::tilt_jacobian(d.centre);
+    const Matrix2d n_cov = camera.normalized_covariance(d.centre, sp) +
+                           o.tilt_sigma * o.tilt_sigma * (T * T.transpose() - Matrix2d::Identity());
+    t.base_cov = J * n_cov * J.transpose();
     if (l.lamp->shape == graph::LampShape::rectangle && l.lamp->length > l.lamp->width) {
       const auto dir = geometry.base_direction(d.centre, d.orientation, l.lamp->xyz.z());
       if (dir) {

@@ -9,6 +9,7 @@
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/ceiling_geometry.hpp"
 #include "lampnav/fusion/odometry_track.hpp"
+#include "lampnav/vision/camera_models.hpp"
 #include "median.hpp"
 
 namespace lampnav::mapping {
@@ -89,7 +90,7 @@ struct LampMapper::Impl {
       : o(options),
         camera(ceiling_of(robot)),
         geometry(camera),
-        focal_px(camera.pinhole.fx),
+        focal_px(vision::PinholeCamera::intrinsics(camera).fx),
         track(robot.semi_axis, std::chrono::hours(24 * 365)),
         new_height{options.height_guess_m, options.height_guess_m},
         next_solve_m(options.solve_every_m) {
@@ -102,9 +103,10 @@ struct LampMapper::Impl {
     if (!c)
       throw InputError({"robot.json", "", "cameras"},
                        "no camera named \"ceiling_camera\": the map is built from its lamps");
-    if (c->model != CameraModelKind::pinhole)
+    if (!vision::PinholeCamera::takes(c->model))
       throw InputError({"robot.json", "camera ceiling_camera", "model"},
-                       "the ceiling camera must be a pinhole camera (as the lamp detector needs)");
+                       "the ceiling camera must be a pinhole or kannala_brandt camera (as the lamp "
+                       "detector needs)");
     return *c;
   }
 

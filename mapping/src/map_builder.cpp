@@ -12,6 +12,7 @@
 #include "lampnav/fusion/odometry_track.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
+#include "lampnav/vision/camera_models.hpp"
 #include "median.hpp"
 #include "omni_choice.hpp"
 #include "part_placement.hpp"
@@ -189,10 +190,10 @@ std::vector<std::optional<Pose2>> place_parts(
   {
     // The ceiling camera's reach: half the tangent of its narrower half-angle.
     const CameraDescription& c = *robot.find_camera("ceiling_camera");
+    const PinholeParameters k = vision::PinholeCamera::intrinsics(c);
     const double half =
-        std::min({c.pinhole.cx, c.width - c.pinhole.cx, c.pinhole.cy * c.pinhole.fx / c.pinhole.fy,
-                  (c.height - c.pinhole.cy) * c.pinhole.fx / c.pinhole.fy});
-    po.sure_per_height = 0.5 * half / c.pinhole.fx;
+        std::min({k.cx, c.width - k.cx, k.cy * k.fx / k.fy, (c.height - k.cy) * k.fx / k.fy});
+    po.sure_per_height = 0.5 * half / k.fx;
     po.camera_height_m = c.mount.xyz.z();
   }
   const CameraDescription* omni_camera = robot.find_camera("omni_camera");

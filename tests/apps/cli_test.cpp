@@ -338,11 +338,15 @@ TEST(Cli, RobotImportTakesCalibrationsKeepingWheelsAndMounts) {
   EXPECT_EQ(robot.semi_axis, before.semi_axis);
   EXPECT_EQ(robot.find_camera("ceiling_camera")->pinhole.fx,
             before.find_camera("ceiling_camera")->pinhole.fx);
-  // A fisheye cannot be the ceiling camera; a file that is not a calibration names itself.
+  // A Kannala-Brandt calibration can be the ceiling camera too (a wide-angle webcam's lens);
+  // a file that is not a calibration names itself.
   const Result ceiling = run("robot import '" + calib + "' --camera ceiling_camera --robot " +
                              src("maps/robots/pioneer.json") + " -o '" + out + "'");
-  EXPECT_EQ(ceiling.status, 2);
-  EXPECT_THAT(ceiling.err, HasSubstr("must be a pinhole camera"));
+  ASSERT_EQ(ceiling.status, 0) << ceiling.err;
+  EXPECT_THAT(ceiling.out,
+              HasSubstr("ceiling_camera: pinhole 352 x 288 -> kannala_brandt 1280 x 1024"));
+  EXPECT_EQ(read_robot_description(out).find_camera("ceiling_camera")->model,
+            CameraModelKind::kannala_brandt);
   const Result bad = run("robot import " + src("maps/office_floor.geojson") + " --robot " +
                          src("maps/robots/pioneer.json") + " -o '" + out + "'");
   EXPECT_EQ(bad.status, 2);

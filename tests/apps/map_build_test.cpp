@@ -24,13 +24,14 @@ namespace fs = std::filesystem;
 struct Recorded {
   fs::path dir = fs::temp_directory_path() / ("lampnav_map_build_" + std::to_string(::getpid()));
   std::string log = (dir / "drive.mcap").string();
-  // The drive E1 -> K2 on `map` (the office floor's file unless given), `sim` flags added.
+  // The drive E1 -> K2 on `map` (the office floor's file unless given) by `robot` (the bundled
+  // one unless given), `sim` flags added.
   explicit Recorded(const std::string& map = test::source_path("maps/office_floor.geojson"),
-                    const std::string& flags = "") {
+                    const std::string& flags = "",
+                    const std::string& robot = test::source_path("maps/robots/pioneer.json")) {
     fs::create_directories(dir);
-    const auto r = test::run_lampnav("sim --route 'E1 -> K2' --map '" + map + "' --robot " +
-                                     test::quoted_source("maps/robots/pioneer.json") + " -o '" +
-                                     log + "' " + flags);
+    const auto r = test::run_lampnav("sim --route 'E1 -> K2' --map '" + map + "' --robot '" +
+                                     robot + "' -o '" + log + "' " + flags);
     EXPECT_EQ(r.status, 0) << r.err;
   }
   ~Recorded() { fs::remove_all(dir); }
@@ -394,6 +395,52 @@ TEST(MapBuild, ACarryPutDownBesideALampCutByTheBorderIsFound) {
     EXPECT_LE(e.worst, 0.05);
   }
   fs::remove_all(dir);
+}
+
+// A wide-angle webcam calibrated as Kannala-Brandt (cv::fisheye, ROS's equidistant) as the ceiling
+// camera: 352 x 288 at fx 200, its corners 64 degrees off the axis (the pinhole's, 39). The drive
+// E1 -> K2 replays as well as with the pinhole webcam (0.56 cm RMS), never lost once found, and
+// maps every lamp it passed under. Before the ceiling pipeline took the model it was refused;
+// then, with candidates for a label only from the place and its neighbours, the replay was lost 6
+// times for 11.6 s (lamps two places away labelled none), and with a pixel's and a floor bump's
+// error taken alike across the image, twice for 13.4 s (lamps far off the axis disagreeing with
+// the middle ones).
+TEST(MapBuild, AWideAngleCeilingCameraCalibratedAsKannalaBrandtTracksAndMaps) {
+  nlohmann::json robot =
+      nlohmann::json::parse(test::slurp(test::source_path("maps/robots/pioneer.json")));
+  for (auto& c : robot["cameras"]) {
+    if (c["name"] != "ceiling_camera") continue;
+    c.erase("distortion");
+    c["model"] = "kannala_brandt";
+    c["fx"] = 200.0;
+    c["fy"] = 200.0;
+    c["k"] = {0.02, -0.005, 0.0, 0.0};
+  }
+  const fs::path robot_path =
+      fs::temp_directory_path() / ("lampnav_wide_" + std::to_string(::getpid()) + ".json");
+  std::ofstream(robot_path) << robot.dump();
+  const std::string map = test::source_path("maps/office_floor.geojson");
+  const Recorded rec(map, "", robot_path.string());
+  fs::remove(robot_path);
+  const std::string out = (rec.dir / "replay").string();
+  const auto r = test::run_lampnav("replay '" + rec.log + "' --out '" + out + "' --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto m = nlohmann::json::parse(test::slurp(out + "/metrics.json"));
+  std::cout << r.out;
+  EXPECT_LE(m["position_error_m"]["rms"].get<double>(), 0.01);
+  EXPECT_EQ(m["wrong_fixes"].get<int>(), 0);
+  EXPECT_LE(m["lost_s"].get<double>(), 9.0);  // only until the omni camera first finds it
+  const std::string built = (rec.dir / "built.geojson").string();
+  const auto b = test::run_lampnav("map build '" + rec.log + "' -o '" + built + "' --quiet");
+  ASSERT_EQ(b.status, 0) << b.err;
+  const graph::TopologicalMap truth = graph::read_map(map).map;
+  const io::MissionLog log = io::read_mission_log(rec.log);
+  const LampErrors e = lamp_errors(graph::read_map(built).map, truth, log.truth.front().value.pose);
+  std::cout << e.matched.size() << " lamps, error rms " << e.rms * 100 << " cm, max "
+            << e.worst * 100 << " cm\n";
+  EXPECT_EQ(e.matched.size(), lamps_under_the_drive(truth));
+  EXPECT_LE(e.rms, 0.02);
+  EXPECT_LE(e.worst, 0.05);
 }
 
 // A building whose lamps hang 8 m up (a hall, a warehouse): map build does not assume the

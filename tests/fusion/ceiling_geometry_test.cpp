@@ -69,11 +69,18 @@ graph::Lamp rect(const char* id, double x, double y, double yaw) {
 }
 
 // A detection of `lamp` from `pose` with normalized noise `sigma` (and axis noise).
+// `sigma` in the normalized plane, or in pixels through `lens` when given.
 vision::LampDetection see(const CeilingGeometry& g, const Pose2& pose, const graph::Lamp& lamp,
-                          std::mt19937& rng, double sigma, double axis_sigma) {
+                          std::mt19937& rng, double sigma, double axis_sigma,
+                          const vision::PinholeCamera* lens = nullptr) {
   std::normal_distribution<double> n(0, 1);
   vision::LampDetection d;
-  d.centre = *g.predict(pose, lamp.xyz) + sigma * Vector2d(n(rng), n(rng));
+  d.centre = *g.predict(pose, lamp.xyz);
+  if (lens)
+    d.centre = lens->normalized_of_pixel(lens->pixel_of_normalized(d.centre) +
+                                         sigma * Vector2d(n(rng), n(rng)));
+  else
+    d.centre += sigma * Vector2d(n(rng), n(rng));
   const Vector3d e(std::cos(lamp.yaw) * 0.05, std::sin(lamp.yaw) * 0.05, 0);
   const Vector2d a = *g.predict(pose, lamp.xyz + e) - *g.predict(pose, lamp.xyz - e);
   d.orientation = std::atan2(a.y(), a.x()) + axis_sigma * n(rng);
@@ -88,34 +95,38 @@ TEST(PoseFromLamps, OneRectangleGivesThePoseOnTheBranchOfThePrediction) {
   const auto d = see(g, truth, lamp, rng, 0, 0);
   PoseMeasurementOptions o;
   for (double off : {0.0, 0.3, -1.2}) {
-    const auto m = measure_pose(g, 300, {{&lamp, d}}, Pose2(2.7, 1.1, 0.5 + off), Stamp{}, o);
+    const auto m = measure_pose(g, vision::PinholeCamera(ceiling_camera()), {{&lamp, d}},
+                                Pose2(2.7, 1.1, 0.5 + off), Stamp{}, o);
     ASSERT_TRUE(m);
     EXPECT_THAT(m->pose, test::IsNearPose(truth, 1e-9, 1e-9));
   }
   // Predicted facing the other way: the rectangle's other branch.
-  const auto flipped = measure_pose(g, 300, {{&lamp, d}}, Pose2(2.6, 1.2, 0.5 + M_PI), Stamp{}, o);
+  const auto flipped = measure_pose(g, vision::PinholeCamera(ceiling_camera()), {{&lamp, d}},
+                                    Pose2(2.6, 1.2, 0.5 + M_PI), Stamp{}, o);
   ASSERT_TRUE(flipped);
   EXPECT_NEAR(std::fabs(wrap_angle(flipped->pose.yaw() - truth.yaw())), M_PI, 1e-9);
 }
 
-// The reported covariance is the spread of the measurement under the modelled pixel noise.
+// The reported covariance is the spread of the measurement under the modelled pixel noise (in
+// pixels, through the lens: a pixel spans more of the normalized plane towards the image's edge).
 TEST(PoseFromLamps, CovarianceMatchesMonteCarloSpread) {
   const CeilingGeometry g(ceiling_camera());
+  const vision::PinholeCamera lens(ceiling_camera());
   const graph::Lamp a = rect("A", 3.0, 1.0, 0.0), b = rect("B", 5.25, 1.0, 0.0);
   const Pose2 truth(4.0, 1.1, 0.1);
   PoseMeasurementOptions o;
   o.tilt_sigma = 0;    // the simulation below has no tilt
   o.map_sigma = 1e-6;  // nor survey error
   std::mt19937 rng(3);
-  const double sn = o.pixel_sigma / 300;
+  const double sp = o.pixel_sigma;
   Eigen::Matrix3d reported = Eigen::Matrix3d::Zero(), spread = Eigen::Matrix3d::Zero();
   const int n = 4000;
   std::string why;
   int refused = 0;
   for (int i = 0; i < n; ++i) {
-    const auto m = measure_pose(g, 300,
-                                {{&a, see(g, truth, a, rng, sn, o.orientation_sigma)},
-                                 {&b, see(g, truth, b, rng, sn, o.orientation_sigma)}},
+    const auto m = measure_pose(g, lens,
+                                {{&a, see(g, truth, a, rng, sp, o.orientation_sigma, &lens)},
+                                 {&b, see(g, truth, b, rng, sp, o.orientation_sigma, &lens)}},
                                 truth, Stamp{}, o, &why);
     if (!m) {  // the consistency gate refuses its tail of honest frames (p = 1e-4)
       ++refused;
@@ -138,16 +149,17 @@ TEST(PoseFromLamps, RefusesWhatCannotGiveAPose) {
   std::mt19937 rng(1);
   const Pose2 truth(3.1, 1.0, 0.2);
   std::string why;
-  EXPECT_FALSE(
-      measure_pose(g, 300, {{&disc, see(g, truth, disc, rng, 0, 0)}}, truth, Stamp{}, {}, &why));
+  EXPECT_FALSE(measure_pose(g, vision::PinholeCamera(ceiling_camera()),
+                            {{&disc, see(g, truth, disc, rng, 0, 0)}}, truth, Stamp{}, {}, &why));
   EXPECT_EQ(why, "one round lamp does not give the heading");
   // Two lamps labelled the wrong way round disagree.
   const graph::Lamp a = rect("A", 3.0, 1.0, 0.0), b = rect("B", 4.2, 1.9, 1.0);
-  EXPECT_FALSE(measure_pose(g, 300,
+  EXPECT_FALSE(measure_pose(g, vision::PinholeCamera(ceiling_camera()),
                             {{&a, see(g, truth, b, rng, 0, 0)}, {&b, see(g, truth, a, rng, 0, 0)}},
                             truth, Stamp{}, {}, &why));
   EXPECT_THAT(why, testing::HasSubstr("mislabelled"));
-  EXPECT_FALSE(measure_pose(g, 300, {}, truth, Stamp{}, {}, &why));
+  EXPECT_FALSE(
+      measure_pose(g, vision::PinholeCamera(ceiling_camera()), {}, truth, Stamp{}, {}, &why));
 }
 
 }  // namespace

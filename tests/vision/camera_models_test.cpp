@@ -1,3 +1,4 @@
+#include <Eigen/LU>
 #include <opencv2/calib3d.hpp>
 #include <random>
 
@@ -199,6 +200,84 @@ TEST(KannalaBrandt, RobotJsonRoundTrip) {
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), ::testing::HasSubstr("a: unknown key"));
   }
+}
+
+// A wide-angle webcam calibrated with cv::fisheye as the ceiling camera: the ceiling pipeline's
+// model (PinholeCamera, through the normalized plane) against OpenCV's own distortion
+// (cv::fisheye::distortPoints) over the whole image, and its undistortion against
+// cv::fisheye::undistortPoints.
+CameraDescription wide_ceiling_camera() {
+  CameraDescription d = kannala_brandt(345.0, 343.5);
+  d.name = "ceiling_camera";
+  d.width = 640;
+  d.height = 480;
+  d.fisheye.u0 = 321.4;
+  d.fisheye.v0 = 238.7;
+  d.fisheye.k = {0.031, -0.012, 0.0021, -0.00017};
+  return d;
+}
+
+TEST(KannalaBrandtCeiling, AgreesWithOpenCvsFisheyeOverTheWholeImage) {
+  const CameraDescription d = wide_ceiling_camera();
+  const PinholeCamera cam(d);
+  EXPECT_TRUE(cam.equidistant());
+  const PinholeParameters k = PinholeCamera::intrinsics(d);
+  const cv::Matx33d K(k.fx, 0, k.cx, 0, k.fy, k.cy, 0, 0, 1);
+  const cv::Vec4d D(d.fisheye.k[0], d.fisheye.k[1], d.fisheye.k[2], d.fisheye.k[3]);
+  std::vector<cv::Point2d> normalized, pixels;
+  std::vector<Vector2d> ours_px, ours_n;
+  for (int v = 0; v < d.height; v += 4)
+    for (int u = 0; u < d.width; u += 4) {
+      const Vector2d n = cam.normalized_of_pixel(Vector2d(u, v));
+      normalized.emplace_back(n.x(), n.y());
+      pixels.emplace_back(u, v);
+      ours_n.push_back(n);
+      ours_px.push_back(cam.pixel_of_normalized(n));
+      EXPECT_LT((ours_px.back() - Vector2d(u, v)).norm(), 1e-6) << u << ", " << v;
+    }
+  std::vector<cv::Point2d> their_px, their_n;
+  cv::fisheye::distortPoints(normalized, their_px, K, D);
+  cv::fisheye::undistortPoints(pixels, their_n, K, D);
+  double worst_px = 0, worst_n = 0;
+  for (std::size_t i = 0; i < normalized.size(); ++i) {
+    worst_px = std::max(worst_px, (ours_px[i] - Vector2d(their_px[i].x, their_px[i].y)).norm());
+    // OpenCV's undistortion iterates to its own tolerance: compared in pixels at the image.
+    worst_n = std::max(worst_n, k.fx * (ours_n[i] - Vector2d(their_n[i].x, their_n[i].y)).norm());
+  }
+  std::cout << normalized.size() << " pixels, worst difference from OpenCV " << worst_px
+            << " px distorting, " << worst_n << " px undistorting\n";
+  EXPECT_LT(worst_px, 0.01);
+  EXPECT_LT(worst_n, 0.01);
+  // Its corner is 64 degrees off the axis (a normalized radius over 2; the bundled webcam's, 39).
+  EXPECT_GT(cam.normalized_of_pixel(Vector2d(-0.5, -0.5)).norm(), 2.0);
+}
+
+TEST(KannalaBrandtCeiling, JacobiansMatchNumericalDerivatives) {
+  const PinholeCamera cam(wide_ceiling_camera());
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  for (int i = 0; i < 300; ++i) {
+    const Vector2d n(u(rng), u(rng));
+    const Eigen::Matrix2d Jn =
+        test::numerical_jacobian<2, 2>([&](const Vector2d& q) { return cam.distort(q); }, n);
+    EXPECT_LT((cam.distort_jacobian(n) - Jn).norm(), 1e-6 * (1 + Jn.norm())) << n.transpose();
+    const Vector3d p(n.x() * 2.4, n.y() * 2.4, 2.4);
+    const auto J =
+        test::numerical_jacobian<2, 3>([&](const Vector3d& q) { return *cam.project(q); }, p, 1e-7);
+    EXPECT_LT((cam.project_jacobian(p) - J).norm(), 1e-4 * (1 + J.norm())) << n.transpose();
+    EXPECT_LT((cam.undistort(cam.distort(n)) - n).norm(), 1e-12);
+  }
+  // A pixel spans more of the normalized plane off the axis: by the radial stretch of the lens.
+  const double centre = cam.normalized_covariance(Vector2d::Zero(), 1.0).trace();
+  const Vector2d edge(1.8, 0.0);
+  const Eigen::Matrix2d far = cam.normalized_covariance(edge, 1.0);
+  const Eigen::Matrix2d J = Eigen::Vector2d(cam.parameters().fx, cam.parameters().fy).asDiagonal() *
+                            cam.distort_jacobian(edge);
+  EXPECT_LT((far - (J.transpose() * J).inverse()).norm(), 1e-15);
+  EXPECT_GT(far(0, 0), 4 * centre / 2);
+  // Past its field of view (or 89 degrees) it projects nothing.
+  EXPECT_FALSE(cam.project(Vector3d(100, 0, 1)));
+  EXPECT_TRUE(cam.project(Vector3d(2, 0, 1)));
 }
 
 TEST(CeilingView, MatchesThePinholeFootprint) {

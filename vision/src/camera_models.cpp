@@ -1,6 +1,7 @@
 #include "lampnav/vision/camera_models.hpp"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 #include "lampnav/core/error.hpp"
@@ -33,14 +34,73 @@ double fold_radius2(const std::array<double, 5>& k) {
 }
 }  // namespace
 
+bool PinholeCamera::takes(CameraModelKind model) {
+  return model == CameraModelKind::pinhole || model == CameraModelKind::kannala_brandt;
+}
+
+PinholeParameters PinholeCamera::intrinsics(const CameraDescription& d) {
+  if (d.model != CameraModelKind::kannala_brandt) return d.pinhole;
+  const FisheyeParameters& f = d.fisheye;
+  return {f.f, f.f * f.beta, f.u0, f.v0, {}};
+}
+
 PinholeCamera::PinholeCamera(const CameraDescription& d)
-    : p_(d.pinhole), width_(d.width), height_(d.height) {
-  if (d.model != CameraModelKind::pinhole)
-    throw Error("camera '" + d.name + "' is not a pinhole camera");
-  max_r2_ = fold_radius2(p_.distortion);
+    : p_(intrinsics(d)), width_(d.width), height_(d.height) {
+  if (!takes(d.model))
+    throw Error("camera '" + d.name + "' is " + to_string(d.model) +
+                ": the ceiling camera's pipeline takes pinhole or kannala_brandt");
+  if (d.model == CameraModelKind::pinhole) {
+    max_r2_ = fold_radius2(p_.distortion);
+    return;
+  }
+  equidistant_ = true;
+  k_ = d.fisheye.k;
+  // The view's edge: half the field of view, where theta_d stops growing, or 89 degrees (the
+  // normalized plane ends at 90).
+  max_theta_ = std::min(0.5 * d.fisheye.fov_deg, 89.0) * M_PI / 180.0;
+  const int steps = 2000;
+  for (int i = 1; i <= steps; ++i)
+    if (!(theta_d_derivative(max_theta_ * i / steps) > 0)) {
+      max_theta_ = max_theta_ * (i - 1) / steps;
+      break;
+    }
+  max_r2_ = std::pow(std::tan(max_theta_), 2);
+}
+
+double PinholeCamera::theta_d(double t) const {
+  const double t2 = t * t;
+  return t * (1 + t2 * (k_[0] + t2 * (k_[1] + t2 * (k_[2] + t2 * k_[3]))));
+}
+
+double PinholeCamera::theta_d_derivative(double t) const {
+  const double t2 = t * t;
+  return 1 + t2 * (3 * k_[0] + t2 * (5 * k_[1] + t2 * (7 * k_[2] + t2 * 9 * k_[3])));
+}
+
+double PinholeCamera::theta_of(double td) const {
+  // theta_d rises on [0, max_theta_]: Newton's steps from theta = theta_d, kept inside by
+  // bisection's bracket, to double precision.
+  if (!(td > 0)) return 0.0;
+  double lo = 0, hi = max_theta_;
+  if (td >= theta_d(hi)) return hi;
+  double t = std::min(td, hi);
+  for (int i = 0; i < 50; ++i) {
+    const double e = theta_d(t) - td;
+    (e < 0 ? lo : hi) = t;
+    if (std::abs(e) < 1e-15) break;
+    double next = t - e / theta_d_derivative(t);
+    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+    t = next;
+  }
+  return t;
 }
 
 Vector2d PinholeCamera::distort(const Vector2d& xy) const {
+  if (equidistant_) {
+    const double r = xy.norm();
+    if (r < 1e-12) return xy;
+    return xy * (theta_d(std::atan(r)) / r);
+  }
   const auto& k = p_.distortion;
   const double x = xy.x(), y = xy.y();
   const double r2 = x * x + y * y;
@@ -50,6 +110,11 @@ Vector2d PinholeCamera::distort(const Vector2d& xy) const {
 }
 
 Vector2d PinholeCamera::undistort(const Vector2d& xd) const {
+  if (equidistant_) {
+    const double td = xd.norm();
+    if (td < 1e-12) return xd;
+    return xd * (std::tan(theta_of(td)) / td);
+  }
   // Fixed-point iteration (as OpenCV's undistortPoints), then Gauss-Newton polish.
   Vector2d xy = xd;
   for (int i = 0; i < 20; ++i) {
@@ -61,6 +126,14 @@ Vector2d PinholeCamera::undistort(const Vector2d& xd) const {
 }
 
 Eigen::Matrix2d PinholeCamera::distort_jacobian(const Vector2d& xy) const {
+  if (equidistant_) {
+    // distort(xy) = g(r) xy with g = theta_d(atan r) / r: J = g I + g'(r) / r xy xy^T.
+    const double r = xy.norm();
+    if (r < 1e-9) return Eigen::Matrix2d::Identity();
+    const double t = std::atan(r), g = theta_d(t) / r;
+    const double dg = (theta_d_derivative(t) / (1 + r * r) - g) / r;
+    return g * Eigen::Matrix2d::Identity() + (dg / r) * xy * xy.transpose();
+  }
   const auto& k = p_.distortion;
   const double x = xy.x(), y = xy.y();
   const double r2 = x * x + y * y;
@@ -72,6 +145,13 @@ Eigen::Matrix2d PinholeCamera::distort_jacobian(const Vector2d& xy) const {
   J(1, 0) = y * dradial * 2 * x + k[2] * 2 * x + 2 * k[3] * y;
   J(1, 1) = radial + y * dradial * 2 * y + k[2] * 6 * y + 2 * k[3] * x;
   return J;
+}
+
+Eigen::Matrix2d PinholeCamera::normalized_covariance(const Vector2d& xy, double pixel_sigma) const {
+  const Eigen::Matrix2d J =
+      Eigen::Vector2d(p_.fx, p_.fy).asDiagonal() * distort_jacobian(xy);  // d pixel / d xy
+  const Eigen::Matrix2d Ji = J.inverse();
+  return pixel_sigma * pixel_sigma * Ji * Ji.transpose();
 }
 
 Vector2d PinholeCamera::normalized_of_pixel(const Vector2d& px) const {

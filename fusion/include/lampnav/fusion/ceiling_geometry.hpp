@@ -33,6 +33,11 @@ class CeilingGeometry {
   std::optional<double> base_direction(const Eigen::Vector2d& n, double orientation,
                                        double z) const;
 
+  // d n / d (a, b) at normalized coordinates n for a small turn of the camera by a about its x
+  // axis and b about its y axis (a floor bump): a lamp far off the axis moves further, by up to
+  // 1 + |n|^2 times what one overhead does.
+  static Eigen::Matrix2d tilt_jacobian(const Eigen::Vector2d& n);
+
   const Eigen::Matrix3d& mount_rotation() const { return R_; }
   const Eigen::Vector3d& mount_origin() const { return t_; }
 

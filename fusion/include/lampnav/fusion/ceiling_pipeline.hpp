@@ -14,11 +14,8 @@
 #include "lampnav/core/time.hpp"
 #include "lampnav/fusion/pose_from_lamps.hpp"
 #include "lampnav/graph/map.hpp"
+#include "lampnav/vision/camera_models.hpp"
 #include "lampnav/vision/lamp_tracker.hpp"
-
-namespace lampnav::vision {
-class PinholeCamera;
-}
 
 namespace lampnav::fusion {
 
@@ -61,9 +58,10 @@ class LampLabeller {
  private:
   const graph::TopologicalMap* map_;
   CeilingGeometry geometry_;
-  double fx_;
+  vision::PinholeCamera model_;
   LabellerOptions o_;
   double gate_;
+  double reach_m_;  // lamps this far from the robot may be in view
 };
 
 // The detector's shape prior from a map's lamps and the camera's height: the most common kind of

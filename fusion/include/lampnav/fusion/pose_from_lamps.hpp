@@ -15,6 +15,7 @@
 #include "lampnav/core/time.hpp"
 #include "lampnav/fusion/ceiling_geometry.hpp"
 #include "lampnav/graph/map.hpp"
+#include "lampnav/vision/camera_models.hpp"
 #include "lampnav/vision/lamp_detector.hpp"
 
 namespace lampnav::fusion {
@@ -55,8 +56,9 @@ enum class PoseRefusal {
 };
 
 // Measures the pose; nullopt with `why` (words) and `refusal` (kind) when the lamps cannot give
-// one. `fx` converts pixel sigmas to normalized units.
-std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry, double fx,
+// one. `camera` converts pixel sigmas to the normalized plane where each lamp is seen.
+std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry,
+                                            const vision::PinholeCamera& camera,
                                             const std::vector<LabelledLamp>& lamps,
                                             const Pose2& predicted, Stamp stamp,
                                             const PoseMeasurementOptions& options,

@@ -3,6 +3,7 @@
 // pixel CENTRES (OpenCV's convention).
 
 #include <Eigen/Core>
+#include <array>
 #include <optional>
 
 #include "lampnav/core/robot_description.hpp"
@@ -14,15 +15,27 @@ inline bool in_image(const Eigen::Vector2d& px, int width, int height) {
   return px.x() >= -0.5 && px.y() >= -0.5 && px.x() <= width - 0.5 && px.y() <= height - 0.5;
 }
 
-// Pinhole with OpenCV's radial-tangential distortion [k1, k2, p1, p2, k3].
+// A central camera seeing less than 90 degrees off its axis, through the normalized plane
+// (x, y) = (X/Z, Y/Z) and a distortion of it, then fx, fy, cx, cy; the ceiling camera's models:
+//  - `pinhole`: OpenCV's radial-tangential distortion [k1, k2, p1, p2, k3];
+//  - `kannala_brandt` (Kalibr's pinhole-equi, OpenCV's cv::fisheye, ROS's equidistant): the
+//    distorted point is (x, y) theta_d / r, r = |(x, y)|, theta = atan(r), theta_d = theta (1 +
+//    k1 theta^2 + k2 theta^4 + k3 theta^6 + k4 theta^8): a wide-angle webcam's lens. Its view
+//    ends at fov_deg / 2 off the axis, where theta_d stops growing, or 89 degrees.
 class PinholeCamera {
  public:
-  // Throws lampnav::Error when the description is not a pinhole camera.
+  // Throws lampnav::Error when the description is neither.
   explicit PinholeCamera(const CameraDescription& description);
+  // fx, fy, cx, cy of either model (a Kannala-Brandt camera's fx, fx beta, u0, v0; no
+  // radial-tangential distortion).
+  static PinholeParameters intrinsics(const CameraDescription& description);
+  // Whether a camera of this model can be the ceiling camera (pinhole or kannala_brandt).
+  static bool takes(CameraModelKind model);
 
   int width() const { return width_; }
   int height() const { return height_; }
   const PinholeParameters& parameters() const { return p_; }
+  bool equidistant() const { return equidistant_; }
 
   // Pixel of a camera-frame point; nullopt behind the lens or beyond the radius where the
   // distortion polynomial folds back.
@@ -37,6 +50,10 @@ class PinholeCamera {
   // Pixel -> undistorted normalized coordinates (x, y) = (X/Z, Y/Z), and back.
   Eigen::Vector2d normalized_of_pixel(const Eigen::Vector2d& pixel) const;
   Eigen::Vector2d pixel_of_normalized(const Eigen::Vector2d& xy) const;
+  // The covariance in the normalized plane, at (x, y), of a pixel error of `pixel_sigma` in
+  // each direction: a pixel spans more of the plane where the lens compresses the view (far
+  // off the axis of a wide lens).
+  Eigen::Matrix2d normalized_covariance(const Eigen::Vector2d& xy, double pixel_sigma) const;
   // d pixel / d (X, Y, Z) of a camera-frame point in front of the lens (analytic).
   Eigen::Matrix<double, 2, 3> project_jacobian(const Eigen::Vector3d& point) const;
   // Whether a pixel lies in the image (pixel centres 0..W-1, 0..H-1, with half a pixel of border).
@@ -45,9 +62,17 @@ class PinholeCamera {
   }
 
  private:
+  // Kannala-Brandt: theta_d of theta, its derivative, and theta of theta_d on [0, max_theta_].
+  double theta_d(double theta) const;
+  double theta_d_derivative(double theta) const;
+  double theta_of(double theta_d) const;
+
   PinholeParameters p_;
   int width_, height_;
-  double max_r2_;  // normalized radius^2 where the distortion stops growing
+  double max_r2_;              // normalized radius^2 where the distortion stops growing
+  bool equidistant_ = false;   // Kannala-Brandt
+  std::array<double, 4> k_{};  // its k1 .. k4
+  double max_theta_ = 0;       // its view's edge off the axis (rad)
 };
 
 // The fisheye models: theta = atan2(sqrt(X^2+Y^2), Z), phi = atan2(Y, X), u = u0 + r cos(phi),
