@@ -443,6 +443,34 @@ TEST(MapBuild, AWideAngleCeilingCameraCalibratedAsKannalaBrandtTracksAndMaps) {
   EXPECT_LE(e.worst, 0.05);
 }
 
+// Carried out of the kitchen 12 s into Kitchen -> Lab 4: the drive before the carry saw only the
+// kitchen's lamps, of another kind, and maps none, so the drive's lamps start where the robot was
+// put down. A survey given where the drive started cannot use that start (it would put the drive
+// where it never was): it says so and places the drive by its lamps, which find the office as
+// it is.
+TEST(MapBuild, ASurveyGivenTheStartOfADriveWhoseFirstPartMapsNoLampPlacesItByItsLamps) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("lampnav_survey_carried_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string log = (dir / "drive.mcap").string();
+  const std::string map = test::source_path("maps/office_floor.geojson");
+  ASSERT_EQ(test::run_lampnav("sim --route 'Kitchen -> Lab 4' --map '" + map + "' --robot " +
+                              test::quoted_source("maps/robots/pioneer.json") +
+                              " --seed 35 --kidnap 12 -o '" + log + "'")
+                .status,
+            0);
+  const Pose2 start = io::read_mission_log(log).truth.front().value.pose;
+  const auto s = test::run_lampnav("map survey '" + map + "' '" + log +
+                                   "' --quiet --initial-pose " + std::to_string(start.x()) + "," +
+                                   std::to_string(start.y()) + "," + std::to_string(start.yaw()));
+  ASSERT_EQ(s.status, 0) << s.err;
+  EXPECT_THAT(s.err, HasSubstr("the drive before it mapped no lamp"));
+  EXPECT_THAT(s.err, HasSubstr("--initial-pose is where the drive started, which is not in the "
+                               "drive's map"));
+  EXPECT_THAT(s.out, HasSubstr("0 failed, 0 moved, 0 new"));
+  fs::remove_all(dir);
+}
+
 // A building whose lamps hang 8 m up (a hall, a warehouse): map build does not assume the
 // office's 2.7 m. Before the lamps' look was learnt from blobs down to a thirtieth of a radian
 // (a 1.2 x 0.3 m lamp 7.7 m above the camera is 0.16 x 0.04 rad), it found no lamp; before lamps
