@@ -59,12 +59,7 @@ LampLabeller::LampLabeller(const graph::TopologicalMap& map, const CameraDescrip
   // How far from the camera a lamp of the map can be seen: the image's farthest corner in the
   // normalized plane (at most 3, 72 degrees off the axis), at the highest lamp, and a metre for
   // the pose's error.
-  double corner = 0;
-  for (const Eigen::Vector2d& px :
-       {Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(camera.width - 0.5, -0.5),
-        Eigen::Vector2d(-0.5, camera.height - 0.5),
-        Eigen::Vector2d(camera.width - 0.5, camera.height - 0.5)})
-    corner = std::max(corner, model_.normalized_of_pixel(px).norm());
+  const double corner = model_.corner_radius();
   double top = 0;
   for (const auto& node : map.nodes())
     for (const auto& l : node.lamps) top = std::max(top, l.xyz.z());
@@ -85,9 +80,8 @@ std::vector<const graph::Lamp*> LampLabeller::candidates(const Pose2& predicted)
     for (const auto& l : map_->node(id).lamps) out.push_back(&l);
   // And every lamp the camera can see from there: a wide lens at a junction sees the lamps of
   // the corridors beyond it, two places away.
-  const std::size_t own = out.size();
   map_->visit_lamps_within(predicted.translation(), reach_m_, [&](const graph::Lamp& l) {
-    if (std::find(out.begin(), out.begin() + own, &l) == out.begin() + own) out.push_back(&l);
+    if (!std::binary_search(nodes.begin(), nodes.end(), l.node)) out.push_back(&l);
   });
   return out;
 }

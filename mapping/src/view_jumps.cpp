@@ -43,11 +43,12 @@ struct Sighting {
 class ViewMotion {
  public:
   ViewMotion(const CameraDescription& cam, const ViewJumpOptions& o)
-      : cam_(cam), model_(cam), o_(o), mount_(cam.mount.xyz.head<2>()), yaw_(cam.mount.rpy.z()) {
-    for (const Vector2d& c :
-         {at(0, 0), at(cam.width - 1, 0), at(0, cam.height - 1), at(cam.width - 1, cam.height - 1)})
-      corner_ = std::max(corner_, c.norm());
-  }
+      : cam_(cam),
+        model_(cam),
+        o_(o),
+        mount_(cam.mount.xyz.head<2>()),
+        yaw_(cam.mount.rpy.z()),
+        corner_(model_.corner_radius()) {}
 
   // Between the frames the wheels moved the robot by `step` (in its frame before).
   void set(const Pose2& step) {

@@ -147,6 +147,14 @@ Eigen::Matrix2d PinholeCamera::distort_jacobian(const Vector2d& xy) const {
   return J;
 }
 
+double PinholeCamera::corner_radius() const {
+  double out = 0;
+  for (const Vector2d& px : {Vector2d(0, 0), Vector2d(width_ - 1, 0), Vector2d(0, height_ - 1),
+                             Vector2d(width_ - 1, height_ - 1)})
+    out = std::max(out, normalized_of_pixel(px).norm());
+  return out;
+}
+
 Eigen::Matrix2d PinholeCamera::normalized_covariance(const Vector2d& xy, double pixel_sigma) const {
   const Eigen::Matrix2d J =
       Eigen::Vector2d(p_.fx, p_.fy).asDiagonal() * distort_jacobian(xy);  // d pixel / d xy

@@ -50,6 +50,8 @@ class PinholeCamera {
   // Pixel -> undistorted normalized coordinates (x, y) = (X/Z, Y/Z), and back.
   Eigen::Vector2d normalized_of_pixel(const Eigen::Vector2d& pixel) const;
   Eigen::Vector2d pixel_of_normalized(const Eigen::Vector2d& xy) const;
+  // How far the image reaches in the normalized plane: its farthest corner pixel's |(x, y)|.
+  double corner_radius() const;
   // The covariance in the normalized plane, at (x, y), of a pixel error of `pixel_sigma` in
   // each direction: a pixel spans more of the plane where the lens compresses the view (far
   // off the axis of a wide lens).
