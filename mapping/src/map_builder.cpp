@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 
 #include "drive_scale.hpp"
@@ -15,6 +16,7 @@
 #include "lampnav/vision/camera_models.hpp"
 #include "median.hpp"
 #include "omni_choice.hpp"
+#include "omni_ways.hpp"
 #include "part_placement.hpp"
 #include "view_jumps.hpp"
 
@@ -35,6 +37,8 @@ void MapBuildOptions::validate() const {
   detector.validate();
   if (probe_frames < 10)
     throw InputError({"map build options", "", "probe_frames"}, "must be at least 10");
+  if (omni_views_for_ways < 0)
+    throw InputError({"map build options", "", "omni_views_for_ways"}, "must not be negative");
   if (!(max_scale_change > 0 && max_scale_change < 0.5))
     throw InputError({"map build options", "", "max_scale_change"},
                      "must be above 0 and below 0.5");
@@ -139,14 +143,21 @@ double scale_for_distances(const graph::TopologicalMap& map, const MapBuildOptio
   return s;
 }
 
-// The omni camera's lamps in each of the log's omni frames (none without an omni camera).
+// The omni camera's lamps in the log's omni frames, at most `most` of them spread over the drive
+// (none without an omni camera).
 std::vector<OmniView> omni_views(const io::MissionLog& log, const std::string& source,
-                                 const RobotDescription& robot) {
+                                 const RobotDescription& robot,
+                                 std::size_t most = std::numeric_limits<std::size_t>::max()) {
   const CameraDescription* cam = robot.find_camera("omni_camera");
-  std::vector<const io::Logged<io::ImageFrame>*> frames;
+  std::vector<const io::Logged<io::ImageFrame>*> all, frames;
   for (const auto& f : log.omni_images)
-    if (f.value.frame_id == "omni_camera") frames.push_back(&f);
-  if (!cam || frames.empty()) return {};
+    if (f.value.frame_id == "omni_camera") all.push_back(&f);
+  if (!cam || all.empty()) return {};
+  if (all.size() <= most) {
+    frames = std::move(all);
+  } else {
+    for (std::size_t k = 0; k < most; ++k) frames.push_back(all[k * all.size() / most]);
+  }
   std::vector<OmniView> views(frames.size());
   std::vector<char> readable(frames.size(), 0);
   for_each_index(
@@ -498,8 +509,18 @@ MapBuildResult build_map(const io::MissionLog& log, const std::string& source,
                          const std::function<void(double)>& progress) {
   MapBuildResult out;
   static_cast<DriveLamps&>(out) = map_drive_lamps(log, source, robot, o, progress);
-  // 3. Places and connections.
-  out.map = build_topology(out.mapped, o.topology, names, &out.topology);
+  // 3. Places and connections, with the lamps the omni camera saw around the drive (ways out it
+  // did not take).
+  std::vector<Eigen::Vector2d> seen;
+  const CameraDescription* omni_camera = robot.find_camera("omni_camera");
+  if (omni_camera && o.topology.way_min_lamps > 0) {
+    std::vector<double> heights;
+    for (const auto& l : out.mapped.lamps) heights.push_back(l.xyz.z());
+    seen = lamps_seen_around(
+        omni_views(log, source, robot, static_cast<std::size_t>(o.omni_views_for_ways)),
+        out.mapped.keyframes, *omni_camera, median(heights), OmniLampsOptions{});
+  }
+  out.map = build_topology(out.mapped, o.topology, names, &out.topology, seen);
   if (out.map.edge_count() == 0)
     throw JobFailed(source +
                     ": the drive has no straight stretch long enough to make a "
@@ -513,7 +534,8 @@ MapBuildResult build_map(const io::MissionLog& log, const std::string& source,
     const Eigen::Vector2d about = o.start ? o.start->translation() : Eigen::Vector2d::Zero();
     scale_drive(out.mapped, out.scale, about, robot.find_camera("ceiling_camera")->mount.xyz.z());
     out.travel_m *= out.scale;
-    out.map = build_topology(out.mapped, o.topology, names, &out.topology);
+    for (auto& p : seen) p = about + out.scale * (p - about);
+    out.map = build_topology(out.mapped, o.topology, names, &out.topology, seen);
     out.topology.notes.insert(out.topology.notes.end(), scale_notes.begin(), scale_notes.end());
   }
   // The drive's notes (frames skipped, a jump of the view) first, then the places'.

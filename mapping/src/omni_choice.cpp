@@ -37,25 +37,13 @@ graph::TopologicalMap joined(const DrivePart& map, const DrivePart& part, const 
   return out;
 }
 
-// Where a drive was at `t`, from its keyframes (in time order); nullopt outside them.
-std::optional<Pose2> pose_at(const std::vector<KeyframePose>& keyframes, Stamp t) {
-  if (keyframes.empty() || t < keyframes.front().stamp || t > keyframes.back().stamp)
-    return std::nullopt;
-  auto it = std::lower_bound(keyframes.begin(), keyframes.end(), t,
-                             [](const KeyframePose& k, Stamp s) { return k.stamp < s; });
-  if (it == keyframes.begin() || it->stamp == t) return it->pose;
-  const KeyframePose& a = *(it - 1);
-  const double f = to_seconds(t - a.stamp) / std::max(1e-9, to_seconds(it->stamp - a.stamp));
-  return interpolate(a.pose, it->pose, f);
-}
-
 // At most `n` of the views, spread evenly, each with the drive's pose then.
 std::vector<std::pair<const OmniView*, Pose2>> posed(const std::vector<const OmniView*>& views,
                                                      const std::vector<KeyframePose>& keyframes,
                                                      int n) {
   std::vector<std::pair<const OmniView*, Pose2>> all;
   for (const OmniView* v : views)
-    if (const auto p = pose_at(keyframes, v->stamp)) all.emplace_back(v, *p);
+    if (const auto p = pose_at(keyframes, v->stamp, kNoGap)) all.emplace_back(v, *p);
   if (static_cast<int>(all.size()) <= n) return all;
   std::vector<std::pair<const OmniView*, Pose2>> out;
   for (int k = 0; k < n; ++k) out.push_back(all[k * all.size() / n]);
@@ -63,6 +51,20 @@ std::vector<std::pair<const OmniView*, Pose2>> posed(const std::vector<const Omn
 }
 
 }  // namespace
+
+std::optional<Pose2> pose_at(const std::vector<KeyframePose>& keyframes, Stamp t, double max_gap_s,
+                             double max_turn) {
+  if (keyframes.empty() || t < keyframes.front().stamp || t > keyframes.back().stamp)
+    return std::nullopt;
+  auto it = std::lower_bound(keyframes.begin(), keyframes.end(), t,
+                             [](const KeyframePose& k, Stamp s) { return k.stamp < s; });
+  if (it->stamp == t) return it->pose;
+  const KeyframePose& a = *(it - 1);
+  const double gap = to_seconds(it->stamp - a.stamp);
+  if (gap > max_gap_s || std::abs(wrap_angle(it->pose.yaw() - a.pose.yaw())) > max_turn)
+    return std::nullopt;
+  return interpolate(a.pose, it->pose, to_seconds(t - a.stamp) / std::max(1e-9, gap));
+}
 
 OmniChoice choose_by_omni(const DrivePart& map, const DrivePart& part,
                           const std::vector<PlacementFit>& candidates,

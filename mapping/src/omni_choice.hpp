@@ -26,6 +26,14 @@ struct OmniView {
   vision::OmniDetection detection;
 };
 
+// Where a drive was at `t`, between its keyframes (in time order) on either side; nullopt outside
+// them, between two more than `max_gap_s` apart (a part of the drive left out between them), or
+// two whose headings differ by more than `max_turn` (rad: a turn, where the interpolated heading
+// is least sure).
+inline constexpr double kNoGap = 1e18;
+std::optional<Pose2> pose_at(const std::vector<KeyframePose>& keyframes, Stamp t, double max_gap_s,
+                             double max_turn = kNoGap);
+
 struct OmniChoiceOptions {
   double position_sigma_m = 0.05;  // the drive's pose at a view, from its keyframes
   double yaw_sigma = 0.02;         // rad

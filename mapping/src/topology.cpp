@@ -8,6 +8,7 @@
 #include "halls.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/graph/geojson.hpp"
+#include "omni_ways.hpp"
 
 namespace lampnav::mapping {
 
@@ -32,6 +33,15 @@ void TopologyOptions::validate() const {
   check(hall_min_lamps >= 0, "hall_min_lamps", "must not be negative");
   check(hall_link_m > 0, "hall_link_m", "must be positive");
   check(hall_link_per_height >= 0, "hall_link_per_height", "must not be negative");
+  check(way_min_lamps >= 0 && way_min_lamps != 1, "way_min_lamps",
+        "must be 0 (no ways seen) or at least 2");
+  check(way_across_m > 0, "way_across_m", "must be positive");
+  check(way_gap_m > 0, "way_gap_m", "must be positive");
+  check(way_first_lamp_m > 0, "way_first_lamp_m", "must be positive");
+  check(way_beside_m >= 0, "way_beside_m", "must not be negative");
+  check(way_clear_m >= 0, "way_clear_m", "must not be negative");
+  check(way_min_angle_deg > 0 && way_min_angle_deg <= 90, "way_min_angle_deg",
+        "must be 0 to 90 degrees");
 }
 
 namespace {
@@ -42,6 +52,7 @@ struct Place {
   Vector2d point = Vector2d::Zero();
   int members = 0;
   std::vector<Vector2d> ways;
+  std::vector<Vector2d> seen;  // of the ways, those seen and not driven
   graph::Place kind = graph::Place::junction;
   int node = -1;
   int hall = -1;  // a hall: its index, its region in `region`
@@ -87,7 +98,8 @@ graph::Polygon rectangle(const Vector2d& a, const Vector2d& b, double width) {
 }  // namespace
 
 graph::TopologicalMap build_topology(const MappingResult& mapped, const TopologyOptions& o,
-                                     const std::vector<PlaceName>& names, TopologyReport* report) {
+                                     const std::vector<PlaceName>& names, TopologyReport* report,
+                                     const std::vector<Vector2d>& seen) {
   o.validate();
   TopologyReport rep;
   const double w = o.corridor_width_m;
@@ -188,6 +200,67 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     if (r.hall0 < 0) add_place(lines[r.line].at(r.s0));
     if (r.hall1 < 0) add_place(lines[r.line].at(r.s1));
   }
+  // 2b. Ways out not driven: rows of the lamps seen around the drive (not the runs' own) that
+  // start beside a run and go away from it. Where one meets a run is a place.
+  struct SeenWay {
+    Vector2d at, way;
+  };
+  std::vector<SeenWay> seen_ways;
+  if (o.way_min_lamps > 0 && !seen.empty()) {
+    std::vector<Vector2d> around;
+    for (const Vector2d& p : seen) {
+      bool own = false;
+      for (const auto& r : runs) {
+        const Line& L = lines[r.line];
+        const double s = L.along(p);
+        own = own || (L.across(p) < o.same_line_m && s > r.s0 - o.place_m && s < r.s1 + o.place_m);
+      }
+      if (!own) around.push_back(p);
+    }
+    const double min_sin = std::sin(o.way_min_angle_deg * M_PI / 180);
+    for (const LampRow& row : lamp_rows(around, o.way_min_lamps, o.way_across_m, o.way_gap_m)) {
+      const Vector2d u = row.dir();
+      // A corridor's row has no lamp beside it: lamps off the row's line but near it (a
+      // diagonal through a room's grid of lamps) make it no way.
+      const double length = (row.last - row.first).norm();
+      bool cluttered = false;
+      for (const Vector2d& p : around) {
+        const Vector2d e = p - row.first;
+        const double off = std::abs(u.x() * e.y() - u.y() * e.x()), s = u.dot(e);
+        cluttered = cluttered || (off > 4 * o.way_across_m && off < o.way_clear_m &&
+                                  s > -o.way_clear_m && s < length + o.way_clear_m);
+      }
+      if (cluttered) continue;
+      for (const auto& r : runs) {
+        const Line& L = lines[r.line];
+        const double cross = L.dir.x() * u.y() - L.dir.y() * u.x();
+        if (std::abs(cross) < min_sin) continue;
+        // Where the row's line meets the run's, and the row's ends from there along the row.
+        const Vector2d d = row.first - L.origin;
+        const double s = (d.x() * u.y() - d.y() * u.x()) / cross;
+        if (s < r.s0 - o.place_m || s > r.s1 + o.place_m) continue;
+        const Vector2d at = L.at(s);
+        const double a = (row.first - at).dot(u), b = (row.last - at).dot(u);
+        if (a * b <= 0 || std::min(std::abs(a), std::abs(b)) > o.way_first_lamp_m) continue;
+        seen_ways.push_back({at, a > 0 ? u : Vector2d(-u)});
+      }
+    }
+    // A corridor's lamps are one row; rows side by side going the same way (a room's or a
+    // hall's grid of lamps, seen through walls or a door) are no way out.
+    const double same_way = std::cos(15 * M_PI / 180);
+    std::vector<SeenWay> alone;
+    for (const SeenWay& x : seen_ways) {
+      bool beside = false;
+      for (const SeenWay& y : seen_ways) {
+        const double apart = (y.at - x.at).norm();
+        beside = beside || (y.way.dot(x.way) > same_way && apart > o.way_across_m + 0.7 &&
+                            apart < o.way_beside_m);
+      }
+      if (!beside) alone.push_back(x);
+    }
+    seen_ways = std::move(alone);
+    for (const SeenWay& x : seen_ways) add_place(x.at);
+  }
   // Ways out of each place: the runs that go on from it by more than a place's size.
   // Where a point lies along a run (the distance along its line), if the run passes it.
   auto along_run = [&](const Run& r, const Vector2d& p) -> std::optional<double> {
@@ -211,6 +284,7 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
       bool known = false;
       for (const auto& v : q.ways) known = known || v.dot(way) > std::cos(20 * M_PI / 180);
       if (!known) q.ways.push_back(way);
+      return !known;
     };
     for (const auto& [r, s] : runs_through(q)) {
       const Vector2d d = lines[r->line].dir;
@@ -227,6 +301,11 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
       if (to.norm() > 1e-6) add_way(to.normalized());  // into the hall next to it
       q.beside.push_back(static_cast<int>(h));
     }
+    // Ways seen and not driven count where they change the place's kind: a junction the drive
+    // went three ways out of stays as it is.
+    const std::size_t driven = q.ways.size();
+    for (const SeenWay& s : seen_ways)
+      if (driven < 3 && (s.at - q.point).norm() < near && add_way(s.way)) q.seen.push_back(s.way);
     const std::size_t n = q.ways.size();
     if (n == 2 && q.ways[0].dot(q.ways[1]) < -std::cos(20 * M_PI / 180)) continue;  // straight on
     q.kind = n <= 1 ? graph::Place::end : n == 2 ? graph::Place::corner : graph::Place::junction;
@@ -459,6 +538,24 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
         "the drive was all in one hall: it is cut in two halves across its length, " + first.name +
         " and " + second.name +
         ", so that the map has a way between places (merge or rename them by hand)");
+  }
+
+  // The ways out counted but not driven, for the user: they are not in the map.
+  for (const Place& q : places) {
+    if (q.seen.empty() || q.node < 0 || dropped[q.node]) continue;
+    rep.ways_seen += q.seen.size();
+    std::string headings;
+    for (const Vector2d& way : q.seen) {
+      const double deg = std::atan2(way.y(), way.x()) * 180 / M_PI;
+      headings += (headings.empty() ? "" : " and ") +
+                  std::to_string(static_cast<int>(std::lround(deg < 0 ? deg + 360 : deg)));
+    }
+    rep.notes.push_back(nodes[q.node].name + " is a " + graph::to_string(q.kind) + " by " +
+                        (q.seen.size() == 1 ? "a way" : "ways") +
+                        " out the omni camera saw and the drive did not take (heading " + headings +
+                        " degrees in the map's frame): drive " +
+                        (q.seen.size() == 1 ? "it" : "them") + " to map " +
+                        (q.seen.size() == 1 ? "its corridor" : "their corridors"));
   }
 
   // 5. Lamps into the place whose region holds them, in walking order.

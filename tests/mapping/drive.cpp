@@ -19,7 +19,7 @@ DriveRecord drive_through(const std::vector<Eigen::Vector2d>& waypoints, double 
   Pose2 truth(waypoints.front(), start_yaw);
   rec.start = truth;
   const double dt = 0.02;
-  double t = 0, left = 0, right = 0, next_frame = 0.01;
+  double t = 0, left = 0, right = 0, next_frame = 0.01, next_omni = 0.015;
   auto stamp = [](double s) { return Stamp(std::chrono::nanoseconds(std::llround(s * 1e9))); };
   auto step = [&](double v, double w) {
     truth = truth * Pose2(v * dt, 0.0, w * dt);
@@ -32,6 +32,10 @@ DriveRecord drive_through(const std::vector<Eigen::Vector2d>& waypoints, double 
     if (t >= next_frame) {
       next_frame += 1.0 / o.ceiling_rate;
       rec.frames.push_back({stamp(t), truth, sensors.ceiling(truth, rng)});
+    }
+    if (o.omni_rate > 0 && t >= next_omni) {
+      next_omni += 1.0 / o.omni_rate;
+      rec.omni.push_back({stamp(t), sensors.omni(truth, rng)});
     }
   };
   rec.wheels.push_back({stamp(0), 0, 0});

@@ -1,6 +1,7 @@
 #pragma once
 // A drive for mapping tests: through waypoints (turn on the spot, then straight), with wheels that
-// have a scale error and noise, and the ideal lamp detections of the ceiling camera at 10 Hz.
+// have a scale error and noise, and the ideal lamp detections of the ceiling camera at 10 Hz (and
+// of the omni camera, when asked).
 
 #include <functional>
 #include <random>
@@ -20,6 +21,7 @@ struct DriveOptions {
   double scale_error_left = 0.004, scale_error_right = -0.003;
   double wheel_noise = 0.002;  // m per sqrt(m)
   double ceiling_rate = 10;    // Hz
+  double omni_rate = 0;        // Hz (0: no omni views)
   std::uint64_t seed = 1;
 };
 
@@ -33,8 +35,13 @@ struct DriveRecord {
     Pose2 truth;
     std::vector<vision::LampDetection> lamps;
   };
+  struct OmniFrame {
+    Stamp stamp;
+    vision::OmniDetection detection;
+  };
   std::vector<Wheels> wheels;
   std::vector<Frame> frames;
+  std::vector<OmniFrame> omni;
   Pose2 start;
   double length_m = 0;
 };

@@ -17,6 +17,7 @@
 #include "lampnav/mapping/rigid_fit.hpp"
 #include "lampnav/sim/building.hpp"
 #include "lampnav_test.hpp"
+#include "omni_ways.hpp"
 
 namespace lampnav::mapping {
 namespace {
@@ -48,18 +49,23 @@ test::DriveRecord every_corridor_drive(const graph::TopologicalMap& truth,
   return test::drive_through(waypoints, std::atan2(d0.y(), d0.x()), sensors, robot.semi_axis);
 }
 
-void expect_same_topology(const graph::TopologicalMap& built, const graph::TopologicalMap& truth,
-                          const Pose2& drive_start) {
-  // The built map into the true one's frame: by the drive's true start, then by the rigid motion
-  // that best puts its lamps on the true lamps nearest them (the map's frame is its first
-  // keyframe's, whose heading is a fraction of a degree off after turns on the spot).
+// The built map into the true one's frame: by the drive's true start, then by the rigid motion
+// that best puts its lamps on the true lamps nearest them (the map's frame is its first
+// keyframe's, whose heading is a fraction of a degree off after turns on the spot).
+Pose2 built_to_true(const graph::TopologicalMap& built, const graph::TopologicalMap& truth,
+                    const Pose2& drive_start) {
   std::vector<std::pair<Vector2d, Vector2d>> pairs;
   for (const auto& n : built.nodes())
     for (const auto& l : n.lamps) {
       const auto near = truth.lamps_within(drive_start.transform_from(l.xyz.head<2>()), 0.6);
       if (near.size() == 1) pairs.emplace_back(l.xyz.head<2>(), near.front()->xyz.head<2>());
     }
-  const Pose2 start = pairs.size() >= 3 ? fit_rigid(pairs) : drive_start;
+  return pairs.size() >= 3 ? fit_rigid(pairs) : drive_start;
+}
+
+void expect_same_topology(const graph::TopologicalMap& built, const graph::TopologicalMap& truth,
+                          const Pose2& drive_start) {
+  const Pose2 start = built_to_true(built, truth, drive_start);
   // Each built node, moved into the true map's frame, lies in a true node of the same kind.
   std::map<std::int64_t, const graph::Node*> match;
   std::map<graph::Place, int> kinds_built, kinds_true;
@@ -248,6 +254,94 @@ TEST(Topology, RegionsMetAtAnAngleGiveWay) {
   EXPECT_GT(built.node_count(), 2u);
   EXPECT_NO_THROW(graph::parse_map(graph::write_map(built), "built"));
   for (const auto& note : rep.notes) std::cout << note << "\n";
+}
+
+// A drive down part of a building: each built place lies in a true node of the same kind, and
+// each built edge joins places whose true nodes are joined. Returns the places (not corridors)
+// whose kind differs from their true node's, by name.
+std::vector<std::string> places_of_another_kind(const graph::TopologicalMap& built,
+                                                const graph::TopologicalMap& truth,
+                                                const Pose2& drive_start) {
+  const Pose2 start = built_to_true(built, truth, drive_start);
+  std::vector<std::string> out;
+  for (const auto& n : built.nodes()) {
+    const graph::Node* t = truth.node_containing(start.transform_from(n.point));
+    if (!t || t->place != n.place) out.push_back(n.name + " (" + (t ? t->name : "nowhere") + ")");
+  }
+  for (const auto& e : built.edges()) {
+    const graph::Node* a = truth.node_containing(start.transform_from(built.node(e.start).point));
+    const graph::Node* b = truth.node_containing(start.transform_from(built.node(e.end).point));
+    bool linked = false;
+    for (const auto& te : truth.edges())
+      linked = linked || (a && b && te.start == a->id && te.end == b->id);
+    if (!linked) out.push_back(built.node(e.start).name + "-" + built.node(e.end).name);
+  }
+  return out;
+}
+
+// The omni camera's ideal views of a drive, and the lamps they show around it.
+std::vector<Vector2d> seen_around(const test::DriveRecord& drive, const MappingResult& mapped,
+                                  const RobotDescription& robot) {
+  std::vector<OmniView> views;
+  for (const auto& f : drive.omni) views.push_back({f.stamp, f.detection});
+  return lamps_seen_around(views, mapped.keyframes, *robot.find_camera("omni_camera"), 2.7, {});
+}
+
+// Office drives that pass junctions straight through or turn at them, and start or stop at a
+// corner, without going down the ways beside them. By the drive alone, a junction passed straight
+// through is no place (the corridor runs through it), one turned at is a corner, and a corner the
+// drive starts at is an end. The omni camera sees the lamps down the ways not taken: with them,
+// every place is of its true kind and linked as in the true map.
+TEST(Topology, WaysOutTheOmniCameraSawGivePlacesTheirTrueKind) {
+  const test::Office office;
+  test::DriveOptions o;
+  o.omni_rate = 3;
+  const std::vector<std::pair<std::string, std::vector<Vector2d>>> drives = {
+      {"E1 -> J1 -> J2 -> E2", {{1, 10}, {21, 10}, {21, -8}, {1, -8}}},
+      {"K1 -> J1 -> E1", {{41, 10}, {1, 10}}},
+      {"E2 -> J2 -> K2 -> K1", {{1, -8}, {41, -8}, {41, 10}}},
+  };
+  for (const auto& [name, waypoints] : drives) {
+    SCOPED_TRACE(name);
+    const test::DriveRecord drive = office.drive(waypoints, o);
+    const MappingResult mapped = test::map_drive(drive, office.robot);
+    TopologyReport rep, alone;
+    const graph::TopologicalMap built =
+        build_topology(mapped, {}, {}, &rep, seen_around(drive, mapped, office.robot));
+    const graph::LoadedMap reread = graph::parse_map(graph::write_map(built), "built");
+    EXPECT_TRUE(reread.warnings.empty()) << reread.warnings.front().text();
+    const auto wrong = places_of_another_kind(built, office.map, drive.start);
+    EXPECT_TRUE(wrong.empty()) << ::testing::PrintToString(wrong);
+    EXPECT_GE(rep.ways_seen, 1u);
+    // Without the omni camera's lamps, some place is of another kind.
+    const graph::TopologicalMap driven = build_topology(mapped, {}, {}, &alone);
+    EXPECT_FALSE(places_of_another_kind(driven, office.map, drive.start).empty());
+    EXPECT_EQ(alone.ways_seen, 0u);
+    for (const auto& note : rep.notes) std::cout << name << ": " << note << "\n";
+  }
+}
+
+// A drive down every corridor of a generated building with its omni views: no way out is seen
+// that the drive did not take (every way was driven), whatever the rooms' lamps and the parallel
+// corridors the omni camera sees through the simulator's missing walls; the topology is the
+// true one's.
+TEST(Topology, NoWayIsSeenWhereEveryWayWasDriven) {
+  const graph::TopologicalMap truth =
+      generated(30, 7, [](sim::BuildingOptions& bo) { bo.missing_corridors = 2; });
+  const test::Office office;  // for the robot
+  const sim::LampSensors sensors(truth, office.robot);
+  const auto waypoints = test::every_corridor_twice(truth);
+  const Vector2d d0 = waypoints[1] - waypoints[0];
+  test::DriveOptions o;
+  o.omni_rate = 3;
+  const test::DriveRecord drive = test::drive_through(waypoints, std::atan2(d0.y(), d0.x()),
+                                                      sensors, office.robot.semi_axis, o);
+  const MappingResult mapped = test::map_drive(drive, office.robot);
+  TopologyReport rep;
+  const graph::TopologicalMap built =
+      build_topology(mapped, {}, {}, &rep, seen_around(drive, mapped, office.robot));
+  EXPECT_EQ(rep.ways_seen, 0u) << ::testing::PrintToString(rep.notes);
+  expect_same_topology(built, truth, drive.start);
 }
 
 }  // namespace

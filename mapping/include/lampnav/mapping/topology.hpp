@@ -8,7 +8,9 @@
 // closer than a corridor's width cannot be two corridors) over lamps spread across its lanes, and
 // where it saw lamps off to its side in no corridor's row: their region is the lanes and the
 // lamps, and the places and corridors around link to them. What the drive never went down is not in
-// the map: a junction whose third way was never driven comes out a corner.
+// the map, but a way out it did not take counts in its place's kind when the lamps seen around the
+// drive (the omni camera's) stand in a row going away from the place: a junction passed straight
+// through, or turned at, is a junction; without them it comes out no place, or a corner.
 
 #include <map>
 #include <string>
@@ -42,12 +44,27 @@ struct TopologyOptions {
   int hall_min_lamps = 3;
   double hall_link_m = 6.0;
   double hall_link_per_height = 1.5;
+  // Ways out not driven, from the lamps seen around the drive: a row of at least way_min_lamps
+  // of them (0: none), each within way_across_m of the row's line, consecutive ones at most
+  // way_gap_m apart, whose line crosses a run at least way_min_angle_deg from it, its first lamp
+  // at most way_first_lamp_m from the crossing and the row all on one side of it, with no other
+  // such row going the same way within way_beside_m of it and no lamp off its line within
+  // way_clear_m of it (rows side by side, and diagonals, are a room's or a hall's grid of lamps).
+  // Lamps within same_line_m of a run's line, along the run, are its own.
+  int way_min_lamps = 3;
+  double way_across_m = 0.3;
+  double way_gap_m = 5.0;
+  double way_first_lamp_m = 3.0;
+  double way_beside_m = 6.0;
+  double way_clear_m = 4.5;
+  double way_min_angle_deg = 45.0;
   void validate() const;  // throws InputError naming the field
 };
 
 struct TopologyReport {
   std::size_t lamps_placed = 0;
   std::size_t lamps_outside = 0;  // lamps in no place's region (left out of the map)
+  std::size_t ways_seen = 0;      // ways out seen, not driven, that changed a place's kind
   std::vector<std::string> notes;
 };
 
@@ -58,7 +75,10 @@ struct PlaceName {
   std::string name;
 };
 
+// `seen`: lamps seen around the drive, in the map frame (the omni camera's, those the drive passed
+// under among them; empty: the drive's own ways only).
 graph::TopologicalMap build_topology(const MappingResult& mapped, const TopologyOptions& options,
-                                     const std::vector<PlaceName>& names, TopologyReport* report);
+                                     const std::vector<PlaceName>& names, TopologyReport* report,
+                                     const std::vector<Eigen::Vector2d>& seen = {});
 
 }  // namespace lampnav::mapping
