@@ -203,7 +203,8 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
   // 2b. Ways out not driven: rows of the lamps seen around the drive (not the runs' own) that
   // start beside a run and go away from it. Where one meets a run is a place.
   struct SeenWay {
-    Vector2d at, way;
+    Vector2d at, way;  // where its row's line crosses the run, and the way from there
+    Vector2d middle;   // of the row
   };
   std::vector<SeenWay> seen_ways;
   if (o.way_min_lamps > 0 && !seen.empty()) {
@@ -220,17 +221,17 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     const double min_sin = std::sin(o.way_min_angle_deg * M_PI / 180);
     for (const LampRow& row : lamp_rows(around, o.way_min_lamps, o.way_across_m, o.way_gap_m)) {
       const Vector2d u = row.dir();
-      // A corridor's row has no lamp beside it: lamps off the row's line but near it (a
-      // diagonal through a room's grid of lamps) make it no way.
+      // A corridor's row has at most a lamp beside it (a room's, through a door): lamps off the
+      // row's line but near it (a column or a diagonal of a room's grid of lamps) make it no way.
       const double length = (row.last - row.first).norm();
-      bool cluttered = false;
+      int beside = 0;
       for (const Vector2d& p : around) {
         const Vector2d e = p - row.first;
         const double off = std::abs(u.x() * e.y() - u.y() * e.x()), s = u.dot(e);
-        cluttered = cluttered || (off > 4 * o.way_across_m && off < o.way_clear_m &&
-                                  s > -o.way_clear_m && s < length + o.way_clear_m);
+        beside += off > 4 * o.way_across_m && off < o.way_clear_m && s > -o.way_clear_m &&
+                  s < length + o.way_clear_m;
       }
-      if (cluttered) continue;
+      if (beside > 1) continue;
       for (const auto& r : runs) {
         const Line& L = lines[r.line];
         const double cross = L.dir.x() * u.y() - L.dir.y() * u.x();
@@ -242,7 +243,7 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
         const Vector2d at = L.at(s);
         const double a = (row.first - at).dot(u), b = (row.last - at).dot(u);
         if (a * b <= 0 || std::min(std::abs(a), std::abs(b)) > o.way_first_lamp_m) continue;
-        seen_ways.push_back({at, a > 0 ? u : Vector2d(-u)});
+        seen_ways.push_back({at, a > 0 ? u : Vector2d(-u), 0.5 * (row.first + row.last)});
       }
     }
     // A corridor's lamps are one row; rows side by side going the same way (a room's or a
@@ -252,7 +253,9 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     for (const SeenWay& x : seen_ways) {
       bool beside = false;
       for (const SeenWay& y : seen_ways) {
-        const double apart = (y.at - x.at).norm();
+        // Apart across the way (rows through some of the same lamps are not side by side).
+        const Vector2d e = y.middle - x.at;
+        const double apart = std::abs(x.way.x() * e.y() - x.way.y() * e.x());
         beside = beside || (y.way.dot(x.way) > same_way && apart > o.way_across_m + 0.7 &&
                             apart < o.way_beside_m);
       }

@@ -299,6 +299,7 @@ TEST(Topology, WaysOutTheOmniCameraSawGivePlacesTheirTrueKind) {
   const std::vector<std::pair<std::string, std::vector<Vector2d>>> drives = {
       {"E1 -> J1 -> J2 -> E2", {{1, 10}, {21, 10}, {21, -8}, {1, -8}}},
       {"K1 -> J1 -> E1", {{41, 10}, {1, 10}}},
+      {"E1 -> J1 -> J2 -> K2", {{1, 10}, {21, 10}, {21, -8}, {41, -8}}},
       {"E2 -> J2 -> K2 -> K1", {{1, -8}, {41, -8}, {41, 10}}},
   };
   for (const auto& [name, waypoints] : drives) {

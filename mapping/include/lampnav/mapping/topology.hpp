@@ -48,8 +48,9 @@ struct TopologyOptions {
   // of them (0: none), each within way_across_m of the row's line, consecutive ones at most
   // way_gap_m apart, whose line crosses a run at least way_min_angle_deg from it, its first lamp
   // at most way_first_lamp_m from the crossing and the row all on one side of it, with no other
-  // such row going the same way within way_beside_m of it and no lamp off its line within
-  // way_clear_m of it (rows side by side, and diagonals, are a room's or a hall's grid of lamps).
+  // such row going the same way within way_beside_m of it and at most one lamp off its line
+  // within way_clear_m of it (rows side by side, and diagonals, are a room's or a hall's grid of
+  // lamps; one lamp beside is a room's, seen through its door).
   // Lamps within same_line_m of a run's line, along the run, are its own.
   int way_min_lamps = 3;
   double way_across_m = 0.3;
