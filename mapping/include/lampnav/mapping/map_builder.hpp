@@ -36,8 +36,8 @@ struct MapBuildOptions {
   TopologyOptions topology;
   vision::LampDetectorOptions detector;
   int probe_frames = 300;  // frames spread over the drive from which the lamps' look is learnt
-  // Omni frames spread over the drive whose lamps show the ways out it did not take
-  // (TopologyOptions::way_min_lamps; 0 with no omni camera).
+  // At most this many omni frames, spread over the drive, are detected for the ways out it did
+  // not take (TopologyOptions::way_min_lamps; 0: none; a robot without an omni camera has none).
   int omni_views_for_ways = 600;
   // Where the drive started, in the frame the map should have (an existing map's, a floor plan's);
   // without it the map's frame is the start itself (x forward, y left).
