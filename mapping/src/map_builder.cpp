@@ -515,10 +515,14 @@ MapBuildResult build_map(const io::MissionLog& log, const std::string& source,
   const CameraDescription* omni_camera = robot.find_camera("omni_camera");
   if (omni_camera && o.topology.way_min_lamps > 0) {
     std::vector<double> heights;
-    for (const auto& l : out.mapped.lamps) heights.push_back(l.xyz.z());
+    std::vector<Eigen::Vector3d> centres;
+    for (const auto& l : out.mapped.lamps) {
+      heights.push_back(l.xyz.z());
+      centres.push_back(l.xyz);
+    }
     seen = lamps_seen_around(
         omni_views(log, source, robot, static_cast<std::size_t>(o.omni_views_for_ways)),
-        out.mapped.keyframes, *omni_camera, median(heights), OmniLampsOptions{});
+        out.mapped.keyframes, *omni_camera, median(heights), centres, OmniLampsOptions{});
   }
   out.map = build_topology(out.mapped, o.topology, names, &out.topology, seen);
   if (out.map.edge_count() == 0)

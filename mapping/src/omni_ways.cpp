@@ -26,11 +26,55 @@ void OmniLampsOptions::validate() const {
   check(min_views >= 1, "min_views", "must be at least 1");
   check(max_keyframe_gap_s > 0, "max_keyframe_gap_s", "must be positive");
   check(max_turn > 0, "max_turn", "must be positive");
+  check(fit_gate_deg > 0 && fit_gate_deg < 30, "fit_gate_deg", "must be 0 to 30 degrees");
+  check(fit_min_lamps >= 2, "fit_min_lamps", "must be at least 2");
+  check(fit_min_theta >= 0 && fit_min_theta < fit_max_theta && fit_max_theta <= M_PI,
+        "fit_min_theta", "must be 0 to fit_max_theta, which must be at most pi");
 }
+
+namespace {
+
+// The floor's tilt under one view (and the pose's yaw error): the small turn w (rad) of the base
+// about the floor below it that best takes the mapped lamps P (level base frame) to the blobs seen
+// nearest where they should be (within gate_rad). A bump tilts the robot about its wheels, so the
+// camera at t moves with it (1.6 cm for half a degree 1.8 m up: a degree in the direction of a lamp
+// 0.9 m above it): it sees P along P - w x P - t, and a direction q moves by
+// (I - q q^T) (P x w) / |P - t|. Least squares over at least `min` matches; zero without them.
+Vector3d view_turn(const std::vector<Vector3d>& blobs, const std::vector<Vector3d>& lamps,
+                   const Vector3d& t, double gate_rad, int min) {
+  Eigen::Matrix3d AtA = Eigen::Matrix3d::Zero();
+  Vector3d Atb = Vector3d::Zero();
+  int matched = 0;
+  const double cos_gate = std::cos(gate_rad);
+  for (const Vector3d& P : lamps) {
+    const Vector3d q = P - t;
+    const double range = q.norm();
+    const Vector3d u = q / range;
+    const Vector3d* best = nullptr;
+    double best_cos = cos_gate;
+    for (const Vector3d& d : blobs)
+      if (d.dot(u) > best_cos) {
+        best_cos = d.dot(u);
+        best = &d;
+      }
+    if (!best) continue;
+    Eigen::Matrix3d cross;  // P x w = cross w
+    cross << 0, -P.z(), P.y(), P.z(), 0, -P.x(), -P.y(), P.x(), 0;
+    const Eigen::Matrix3d A = (Eigen::Matrix3d::Identity() - u * u.transpose()) * cross / range;
+    AtA += A.transpose() * A;
+    Atb += A.transpose() * (*best - u);
+    ++matched;
+  }
+  if (matched < min) return Vector3d::Zero();
+  return AtA.ldlt().solve(Atb);
+}
+
+}  // namespace
 
 std::vector<Vector2d> lamps_seen_around(const std::vector<OmniView>& views,
                                         const std::vector<KeyframePose>& keyframes,
                                         const CameraDescription& camera, double height_m,
+                                        const std::vector<Eigen::Vector3d>& mapped,
                                         const OmniLampsOptions& o) {
   o.validate();
   const Eigen::Matrix3d R = camera.mount.rotation();
@@ -47,13 +91,29 @@ std::vector<Vector2d> lamps_seen_around(const std::vector<OmniView>& views,
   for (std::size_t v = 0; v < views.size(); ++v) {
     const auto pose = pose_at(keyframes, views[v].stamp, o.max_keyframe_gap_s, o.max_turn);
     if (!pose || views[v].detection.flooded) continue;
+    // The blobs' rays in the base frame, and those of one lamp each for the tilt: not split out
+    // of a bloom, and off the axis within the fit's band (a bloom's centroid lies off its lamp).
+    std::vector<Vector3d> rays, clean;
     for (const vision::OmniBlob& b : views[v].detection.blobs) {
-      const Vector3d d = R * b.ray;  // in the base frame, the floor taken level
+      rays.push_back(R * b.ray);
+      if (!b.from_bloom && b.theta > o.fit_min_theta && b.theta < o.fit_max_theta)
+        clean.push_back(rays.back());
+    }
+    std::vector<Vector3d> near;  // the mapped lamps, level base frame
+    for (const Vector3d& l : mapped) {
+      const Vector2d in_base = pose->transform_to(l.head<2>());
+      const Vector3d P(in_base.x(), in_base.y(), l.z());
+      if (P.z() - t0.z() > 0.1 && (P - t0).head<2>().norm() <= o.max_distance_m) near.push_back(P);
+    }
+    const Vector3d w = view_turn(clean, near, t0, o.fit_gate_deg * M_PI / 180, o.fit_min_lamps);
+    const Vector3d camera_at = t0 + w.cross(t0);  // level frame
+    for (Vector3d d : rays) {
+      d += w.cross(d);  // into the level frame
       if (!(d.z() > 1e-3)) continue;
-      const double t = rise / d.z();
+      const double t = (height_m - camera_at.z()) / d.z();
       const double distance = t * d.head<2>().norm(), slant = distance / rise;
       if (distance > o.max_distance_m) continue;
-      sightings.push_back({pose->transform_from((t0 + t * d).head<2>()),
+      sightings.push_back({pose->transform_from((camera_at + t * d).head<2>()),
                            rise * (1 + slant * slant) * tilt, static_cast<int>(v)});
     }
   }

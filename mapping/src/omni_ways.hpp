@@ -8,7 +8,8 @@
 //     from several views within `cluster_m` of each other are a lamp. Only blobs placed within
 //     `max_distance_m` of the camera count: a blob's direction error moves its lamp by
 //     h dtheta / cos^2(theta) on the ceiling (0.14 m at 9 m for 0.1 degree under a 0.9 m rise; a
-//     floor bump's tilt moves it more, which the lamp's mean weighs).
+//     floor bump's tilt moves it more: each view's tilt is fitted to the lamps the drive mapped
+//     first, and what is left the lamp's mean weighs).
 //  2. `lamp_rows`: lamps in straight rows, consecutive lamps at most `max_gap_m` apart. A row
 //     that starts beside a place and runs away from it is a way out (topology.cpp decides).
 // A building's walls hide what is behind them from a real omni camera; the simulator's images
@@ -37,15 +38,25 @@ struct OmniLampsOptions {
   double max_sigma_m = 0.25;  // nor is one whose mean is less sure than this (from its spreads)
   double max_keyframe_gap_s = 1.0;  // a view between keyframes further apart has no pose
   double max_turn = 0.05;           // rad between the keyframes around a view: turning, not used
-  void validate() const;            // throws InputError naming the field
+  // Each view's tilt (a floor bump, about the floor) and the pose's yaw error are fitted to the
+  // mapped lamps within max_distance_m, each matched to the blob nearest its direction within
+  // fit_gate_deg, from fit_min_lamps of them, with the blobs fit_min_theta to fit_max_theta rad off
+  // the axis that are not split out of a bloom.
+  double fit_gate_deg = 3.0;
+  int fit_min_lamps = 3;
+  double fit_min_theta = 0.6, fit_max_theta = 1.35;
+  void validate() const;  // throws InputError naming the field
 };
 
 // Lamps the omni camera saw around the drive (those the drive passed under among them), in the
-// map frame. `height_m` is the lamps' usual height above the floor.
+// map frame. `height_m` is the lamps' usual height above the floor; `mapped`, the lamps the drive
+// mapped (centres, map frame), to which each view's tilt is fitted.
 std::vector<Eigen::Vector2d> lamps_seen_around(const std::vector<OmniView>& views,
                                                const std::vector<KeyframePose>& keyframes,
                                                const CameraDescription& omni_camera,
-                                               double height_m, const OmniLampsOptions& options);
+                                               double height_m,
+                                               const std::vector<Eigen::Vector3d>& mapped,
+                                               const OmniLampsOptions& options);
 
 struct LampRow {
   Eigen::Vector2d first = Eigen::Vector2d::Zero(), last = Eigen::Vector2d::Zero();

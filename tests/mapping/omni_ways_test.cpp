@@ -14,14 +14,21 @@
 namespace lampnav::mapping {
 namespace {
 
+std::vector<Eigen::Vector3d> centres(const MappingResult& mapped) {
+  std::vector<Eigen::Vector3d> out;
+  for (const auto& l : mapped.lamps) out.push_back(l.xyz);
+  return out;
+}
+
 using Eigen::Vector2d;
 
 // Along the office's north corridor from E1 to K1, past J1 (the middle corridor goes south from
 // it): the lamps the omni camera's views show lie on lamps of the building, the first three of the
 // middle corridor, which the drive never passed under, among them. A floor bump throws a far
 // sighting a metre along its ray now and then, past its lamp's gate; enough of them start a lamp
-// that is not there, within 1.5 m of the lamp (7 of 35 on this drive), mostly on a row's line,
-// where it does not break the row. The omni camera is also mounted turned a quarter turn and off
+// that is not there, within 1.5 m of the lamp (2 and 3 of 32 and 33 on this drive, each view's
+// tilt fitted to the mapped lamps; 7 and 5 of 35 without the fit), mostly on a row's line, where it
+// does not break the row. The omni camera is also mounted turned a quarter turn and off
 // the robot's centre: its mount must be taken into account.
 TEST(OmniWays, LampsSeenAroundLieOnTheBuildingsLamps) {
   test::Office office;
@@ -44,7 +51,7 @@ TEST(OmniWays, LampsSeenAroundLieOnTheBuildingsLamps) {
     const MappingResult mapped = test::map_drive(drive, robot);
     std::vector<OmniView> views;
     for (const auto& f : drive.omni) views.push_back({f.stamp, f.detection});
-    const auto seen = lamps_seen_around(views, mapped.keyframes, *omni, 2.7, {});
+    const auto seen = lamps_seen_around(views, mapped.keyframes, *omni, 2.7, centres(mapped), {});
     ASSERT_GE(seen.size(), 20u);
     int on_a_lamp = 0;
     for (const Vector2d& p : seen) {
@@ -58,7 +65,7 @@ TEST(OmniWays, LampsSeenAroundLieOnTheBuildingsLamps) {
       }
       EXPECT_LT(nearest, 1.5) << at.transpose();  // a lamp's sightings, thrown along the ray
     }
-    EXPECT_GE(on_a_lamp, 0.75 * static_cast<double>(seen.size()));
+    EXPECT_GE(on_a_lamp, 0.85 * static_cast<double>(seen.size()));
     std::cout << on_a_lamp << " of " << seen.size() << " lamps seen lie on a lamp\n";
     for (const double y : {7.75, 5.5, 3.25}) {
       bool found = false;
