@@ -71,6 +71,12 @@ mapping::MappingResult map_drive(const DriveRecord& drive, const RobotDescriptio
   return mapper.finish();
 }
 
+std::vector<Eigen::Vector3d> lamp_centres(const mapping::MappingResult& mapped) {
+  std::vector<Eigen::Vector3d> out;
+  for (const auto& l : mapped.lamps) out.push_back(l.xyz);
+  return out;
+}
+
 graph::TopologicalMap edited(const graph::TopologicalMap& map,
                              const std::function<void(graph::Node&)>& edit) {
   graph::TopologicalMap out(map.name());

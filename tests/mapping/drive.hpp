@@ -51,6 +51,9 @@ struct DriveRecord {
 graph::TopologicalMap edited(const graph::TopologicalMap& map,
                              const std::function<void(graph::Node&)>& edit);
 
+// The centres of the lamps a drive mapped.
+std::vector<Eigen::Vector3d> lamp_centres(const mapping::MappingResult& mapped);
+
 // The lamp SLAM over a recorded drive, wheels and frames in time order.
 mapping::MappingResult map_drive(const DriveRecord& drive, const RobotDescription& robot,
                                  const mapping::LampMapperOptions& options = {});

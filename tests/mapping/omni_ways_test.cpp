@@ -14,12 +14,6 @@
 namespace lampnav::mapping {
 namespace {
 
-std::vector<Eigen::Vector3d> centres(const MappingResult& mapped) {
-  std::vector<Eigen::Vector3d> out;
-  for (const auto& l : mapped.lamps) out.push_back(l.xyz);
-  return out;
-}
-
 using Eigen::Vector2d;
 
 // Along the office's north corridor from E1 to K1, past J1 (the middle corridor goes south from
@@ -51,7 +45,8 @@ TEST(OmniWays, LampsSeenAroundLieOnTheBuildingsLamps) {
     const MappingResult mapped = test::map_drive(drive, robot);
     std::vector<OmniView> views;
     for (const auto& f : drive.omni) views.push_back({f.stamp, f.detection});
-    const auto seen = lamps_seen_around(views, mapped.keyframes, *omni, 2.7, centres(mapped), {});
+    const auto seen =
+        lamps_seen_around(views, mapped.keyframes, *omni, 2.7, test::lamp_centres(mapped), {});
     ASSERT_GE(seen.size(), 20u);
     int on_a_lamp = 0;
     for (const Vector2d& p : seen) {

@@ -22,12 +22,6 @@
 namespace lampnav::mapping {
 namespace {
 
-std::vector<Eigen::Vector3d> centres(const MappingResult& mapped) {
-  std::vector<Eigen::Vector3d> out;
-  for (const auto& l : mapped.lamps) out.push_back(l.xyz);
-  return out;
-}
-
 using Eigen::Vector2d;
 
 // Each built node, moved into the true map's frame by `start`, lies in a true node of the same
@@ -291,7 +285,7 @@ std::vector<Vector2d> seen_around(const test::DriveRecord& drive, const MappingR
   std::vector<OmniView> views;
   for (const auto& f : drive.omni) views.push_back({f.stamp, f.detection});
   return lamps_seen_around(views, mapped.keyframes, *robot.find_camera("omni_camera"), 2.7,
-                           centres(mapped), {});
+                           test::lamp_centres(mapped), {});
 }
 
 // Office drives that pass junctions straight through or turn at them, and start or stop at a
