@@ -2,6 +2,7 @@
 
 #include <ceres/ceres.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -62,6 +63,18 @@ struct HeightFactor {
   template <class T>
   bool operator()(const T* lamp, const T* height, T* r) const {
     r[0] = (lamp[2] - height[0]) / T(s);
+    return true;
+  }
+  double s;
+};
+
+// Two kinds of lamp under one ceiling: their shared heights alike (a Tukey loss lets kinds hung
+// further apart go free).
+struct KindTie {
+  explicit KindTie(double sigma) : s(sigma) {}
+  template <class T>
+  bool operator()(const T* height, const T* other, T* r) const {
+    r[0] = (height[0] - other[0]) / T(s);
     return true;
   }
   double s;
@@ -175,27 +188,40 @@ SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
                                pb.wheels[k][1] - pb.wheels[k - 1][1], pb.semi_axis, sxy, syaw)),
         nullptr, pb.poses[k - 1].data(), pb.poses[k].data(), &pb.wheel_difference);
   }
-  // One shared height per kind of lamp (rectangles, discs), estimated by every solve: a windowed
+  // One shared height per kind of lamp, estimated by every solve: a windowed
   // one that held it at the mean of the heights as they stood would pull the lamps towards the
   // height new lamps are first placed at, and under a ceiling higher than that guess the map's
   // heights would creep up only as fast as windows passed.
-  double kind_height[2] = {0, 0};
-  int kind_count[2] = {0, 0};
+  const std::size_t kinds =
+      pb.kind.empty()
+          ? 0
+          : static_cast<std::size_t>(*std::max_element(pb.kind.begin(), pb.kind.end())) + 1;
+  std::vector<double> kind_height(kinds, 0.0);
+  std::vector<int> kind_count(kinds, 0);
   for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
-    kind_height[pb.rectangle[i] ? 0 : 1] += pb.lamps[i][2];
-    ++kind_count[pb.rectangle[i] ? 0 : 1];
+    kind_height[static_cast<std::size_t>(pb.kind[i])] += pb.lamps[i][2];
+    ++kind_count[static_cast<std::size_t>(pb.kind[i])];
   }
   ceres::HuberLoss height_loss(1.0);
+  ceres::TukeyLoss tie_loss(o.kind_tie_sigma > 0 ? o.kind_tie_max_m / o.kind_tie_sigma : 1.0);
   if (o.shared_height_sigma > 0) {
-    for (int k = 0; k < 2; ++k)
+    for (std::size_t k = 0; k < kinds; ++k)
       if (kind_count[k]) kind_height[k] /= kind_count[k];
+    std::vector<bool> in_problem(kinds, false);
     for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
       if (!in_window[i]) continue;
+      const auto k = static_cast<std::size_t>(pb.kind[i]);
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<HeightFactor, 1, 4, 1>(
                                    new HeightFactor(o.shared_height_sigma)),
-                               &height_loss, pb.lamps[i].data(),
-                               &kind_height[pb.rectangle[i] ? 0 : 1]);
+                               &height_loss, pb.lamps[i].data(), &kind_height[k]);
+      in_problem[k] = true;
     }
+    // Each kind's height tied to the most common kind's (the first).
+    for (std::size_t k = 1; k < kinds && o.kind_tie_sigma > 0; ++k)
+      if (in_problem[k] && in_problem[0])
+        problem.AddResidualBlock(
+            new ceres::AutoDiffCostFunction<KindTie, 1, 1, 1>(new KindTie(o.kind_tie_sigma)),
+            &tie_loss, &kind_height[k], &kind_height[0]);
   }
   bool any_rectangle = false;
   if (o.square_lamps) {

@@ -21,6 +21,7 @@ struct MappingProblem {
   std::vector<double> travel;                 // m from the start at each keyframe
   std::vector<std::array<double, 4>> lamps;   // landmarks (x, y, z, yaw): estimated
   std::vector<bool> rectangle;                // per landmark
+  std::vector<int> kind;                      // per landmark: its kind's shared height
   struct Sighting {
     int keyframe = 0, lamp = 0;
     Eigen::Vector2d centre = Eigen::Vector2d::Zero();  // undistorted normalized

@@ -9,6 +9,7 @@
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/ceiling_geometry.hpp"
 #include "lampnav/fusion/odometry_track.hpp"
+#include "lampnav/mapping/lamp_kinds.hpp"
 #include "lampnav/vision/camera_models.hpp"
 #include "median.hpp"
 
@@ -49,10 +50,13 @@ void LampMapperOptions::validate() const {
   check(wheel_scale_sigma > 0 && wheel_scale_sigma < 0.5, "wheel_scale_sigma", "must be 0 to 0.5");
   check(square_sigma > 0, "square_sigma", "must be positive");
   check(shared_height_sigma >= 0, "shared_height_sigma", "must not be negative");
+  check(kind_tie_sigma >= 0, "kind_tie_sigma", "must not be negative");
+  check(kind_tie_max_m > kind_tie_sigma, "kind_tie_max_m", "must be above kind_tie_sigma");
   check(min_sightings >= 1, "min_sightings", "must be at least 1");
   check(merge_m >= 0 && merge_m < gate_m + 1, "merge_m", "must be 0 to the gate plus 1 m");
   check(max_iterations >= 1, "max_iterations", "must be at least 1");
   check(window_m > 0, "window_m", "must be positive");
+  for (const auto& k : kinds) k.validate();
   check(whole_every_m > 0, "whole_every_m", "must be positive");
 }
 
@@ -74,10 +78,10 @@ struct LampMapper::Impl {
   // Per landmark, the lengths and widths of its sightings, seen from unit distance (one each per
   // sighting: their count is the landmark's sightings).
   std::vector<std::vector<double>> sizes, widths;
-  // The height a new lamp of each kind (rectangles, discs) is first placed at: the guess, then
-  // the median of the solved lamps of its kind. Placed far from its height, a lamp would move
-  // across the ceiling as the robot passes under it and be taken for another.
-  std::array<double, 2> new_height;
+  // The height a new lamp of each kind is first placed at: the guess, then the median of the
+  // solved lamps of its kind. Placed far from its height, a lamp would move across the ceiling as
+  // the robot passes under it and be taken for another.
+  std::vector<double> new_height;
   std::vector<double> last_seen_travel;  // per landmark
   double next_solve_m;
   bool square_set = false;
@@ -92,7 +96,7 @@ struct LampMapper::Impl {
         geometry(camera),
         focal_px(vision::PinholeCamera::intrinsics(camera).fx),
         track(robot.semi_axis, std::chrono::hours(24 * 365)),
-        new_height{options.height_guess_m, options.height_guess_m},
+        new_height(std::max<std::size_t>(2, options.kinds.size()), options.height_guess_m),
         next_solve_m(options.solve_every_m) {
     o.validate();
     pb.semi_axis = robot.semi_axis;
@@ -117,6 +121,15 @@ struct LampMapper::Impl {
     const auto& q = pb.poses.back();
     const Pose2 solved(q[0], q[1], q[2]);
     return solved * pb.odometry.back().between(odometry);
+  }
+
+  // The kind of a lamp seen whole: the nearest learnt kind, or long (0) or round (1).
+  int kind_of(const vision::LampDetection& d) const {
+    if (o.kinds.empty()) return d.length > kLongLamp * d.width ? 0 : 1;
+    return nearest_kind(o.kinds, d.length, d.width);
+  }
+  bool is_rectangle(int kind) const {
+    return o.kinds.empty() ? kind == 0 : o.kinds[static_cast<std::size_t>(kind)].rectangle;
   }
 
   double travel_at(Stamp t) const { return track.travel(track.first_stamp(), t); }
@@ -160,16 +173,17 @@ struct LampMapper::Impl {
     for (const auto& d : lamps) {
       if (d.view != vision::LampView::full) continue;
       // Where the lamp is on the ceiling, at the height of what it joins (or its kind's).
-      const bool rect = d.length > 1.5 * d.width;
-      const double z0 = new_height[rect ? 0 : 1];
+      const int kind = kind_of(d);
+      const bool rect = is_rectangle(kind);
+      const double z0 = new_height[static_cast<std::size_t>(kind)];
       const auto base = geometry.base_point(d.centre, z0);
       if (!base) continue;
       const Vector2d at = est.transform_from(*base);
       const double reach = o.gate_m + 2.0 * base->norm() + 0.5;
-      int best = followed(d.centre, rect, est, last_first, last_end, taken);
+      int best = followed(d.centre, kind, est, last_first, last_end, taken);
       double best_d = o.gate_m;
       for (std::size_t i = 0; best < 0 && i < pb.lamps.size(); ++i) {
-        if (taken[i] || pb.rectangle[i] != rect) continue;
+        if (taken[i] || pb.kind[i] != kind) continue;
         if (!o.close_loops && travel - last_seen_travel[i] > kRevisitM) continue;
         // Far from the guess even for a lamp three times as high above the camera: not a
         // candidate (the placement below moves with the height, by the offset from the robot).
@@ -197,6 +211,7 @@ struct LampMapper::Impl {
         }
         pb.lamps.push_back({at.x(), at.y(), z0, yaw});
         pb.rectangle.push_back(rect);
+        pb.kind.push_back(kind);
         sizes.emplace_back();
         widths.emplace_back();
         last_seen_travel.push_back(travel);
@@ -233,14 +248,14 @@ struct LampMapper::Impl {
   // `centre` is, followed across the image: its sighting there moved by the robot's motion
   // since, at the landmark's height (a wrong height moves it by only the keyframe step over the
   // height); -1 when none is within the tracking gate.
-  int followed(const Vector2d& centre, bool rect, const Pose2& est, std::size_t first,
+  int followed(const Vector2d& centre, int kind, const Pose2& est, std::size_t first,
                std::size_t end, const std::vector<bool>& taken) const {
     int best = -1;
     double best_d = o.track_gate;
     for (std::size_t k = first; k < end; ++k) {
       const auto& s = pb.sightings[k];
       const int i = s.lamp;
-      if (taken[i] || pb.rectangle[i] != rect) continue;
+      if (taken[i] || pb.kind[i] != kind) continue;
       const auto b = geometry.base_point(s.centre, pb.lamps[i][2]);
       if (!b) continue;
       const auto& q = pb.poses[s.keyframe];
@@ -269,10 +284,10 @@ struct LampMapper::Impl {
 
   // Each kind's median solved height, over the landmarks seen often enough to be kept.
   void learn_new_height() {
-    for (int kind = 0; kind < 2; ++kind) {
+    for (std::size_t kind = 0; kind < new_height.size(); ++kind) {
       std::vector<double> z;
       for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
-        if (pb.rectangle[i] == (kind == 0) &&
+        if (pb.kind[i] == static_cast<int>(kind) &&
             static_cast<int>(sizes[i].size()) >= o.min_sightings &&
             pb.lamps[i][2] > geometry.mount_origin().z())
           z.push_back(pb.lamps[i][2]);
@@ -319,7 +334,7 @@ MappingResult LampMapper::finish() {
   for (std::size_t i = 0; m.o.close_loops && i < pb.lamps.size(); ++i) {
     if (into[i] >= 0) continue;
     for (std::size_t j = i + 1; j < pb.lamps.size(); ++j) {
-      if (into[j] >= 0 || pb.rectangle[i] != pb.rectangle[j]) continue;
+      if (into[j] >= 0 || pb.kind[i] != pb.kind[j]) continue;
       const Vector2d d(pb.lamps[i][0] - pb.lamps[j][0], pb.lamps[i][1] - pb.lamps[j][1]);
       if (d.norm() < m.o.merge_m) {
         into[j] = static_cast<int>(i);

@@ -13,6 +13,7 @@
 #include "lampnav/fusion/odometry_track.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
+#include "lampnav/mapping/lamp_kinds.hpp"
 #include "lampnav/vision/camera_models.hpp"
 #include "median.hpp"
 #include "omni_choice.hpp"
@@ -35,6 +36,7 @@ void MapBuildOptions::validate() const {
   mapper.validate();
   topology.validate();
   detector.validate();
+  kinds.validate();
   if (probe_frames < 10)
     throw InputError({"map build options", "", "probe_frames"}, "must be at least 10");
   if (omni_views_for_ways < 0)
@@ -70,6 +72,37 @@ vision::LampShapePrior probe_prior() {
   p.nominal_distance = 1.0;
   p.max_distance = 30.0;
   return p;
+}
+
+// A frame's lamps by a detector of each kind: a lamp seen whole is kept from the detector of its
+// nearest kind (a blob of one kind may pass another's bounds); a cut one, measured with a kind's
+// size, from the first detector (the most common kind) that saw it where no lamp kept lies.
+std::vector<vision::LampDetection> detect_kinds(std::vector<vision::LampDetector>& detectors,
+                                                const std::vector<vision::LampShapePrior>& kinds,
+                                                const Image8& img) {
+  if (detectors.size() == 1) return detectors.front().detect(img).lamps;
+  std::vector<std::vector<vision::LampDetection>> by_kind;
+  for (auto& d : detectors) by_kind.push_back(d.detect(img).lamps);
+  std::vector<vision::LampDetection> out;
+  std::vector<double> reach;  // a kept lamp's half width, normalized
+  for (std::size_t k = 0; k < kinds.size(); ++k)
+    for (const auto& d : by_kind[k])
+      if (d.view == vision::LampView::full &&
+          nearest_kind(kinds, d.length, d.width) == static_cast<int>(k)) {
+        out.push_back(d);
+        reach.push_back(0.5 * d.width);
+      }
+  for (std::size_t k = 0; k < kinds.size(); ++k)
+    for (const auto& d : by_kind[k]) {
+      if (d.view == vision::LampView::full) continue;
+      bool near = false;
+      for (std::size_t j = 0; j < out.size() && !near; ++j)
+        near = (out[j].centre - d.centre).norm() < reach[j] + 0.5 * kinds[k].width;
+      if (near) continue;
+      out.push_back(d);
+      reach.push_back(0.5 * kinds[k].width);
+    }
+  return out;
 }
 
 std::string metres(double m, int decimals = 3) {
@@ -221,14 +254,22 @@ std::vector<std::optional<Pose2>> place_parts(
     return to_seconds(frames[i]->value.stamp - frames.front()->value.stamp);
   };
   const std::size_t first_note = notes.size();
-  while (base + 1 < parts && alone[base].lamps.empty()) ++base;
+  // A part with fewer lamps than a placement needs shared can take no part after it.
+  const std::size_t first_lamps = alone[0].lamps.size();
+  while (base + 1 < parts && alone[base].lamps.size() < static_cast<std::size_t>(po.min_shared))
+    ++base;
   if (base > 0) {
-    char buf[240];
+    char buf[300];
     std::snprintf(buf, sizeof buf,
                   "the ceiling view jumped %.1f s into the drive as no driving could make it (the "
-                  "robot was carried); the drive before it mapped no lamp, so the map starts "
-                  "where the robot was put down",
-                  seconds(starts[base]));
+                  "robot was carried); the drive before it mapped %s, so the map starts where "
+                  "the robot was put down",
+                  seconds(starts[base]),
+                  first_lamps == 0
+                      ? "no lamp"
+                      : (std::to_string(first_lamps) + (first_lamps == 1 ? " lamp" : " lamps") +
+                         ", too few to join the rest to")
+                            .c_str());
     notes.push_back(buf);
   }
   std::vector<MappedLamp> lamps = alone[base].lamps;
@@ -367,56 +408,45 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
   auto since = [](std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
   };
-  // 1. The lamps' look: full blobs from frames spread over the drive, at unit distance.
+  // 1. The lamps' look: full blobs from frames spread over the drive, at unit distance, grouped
+  // into the building's kinds of lamp.
   {
     vision::LampDetectorOptions probe_options = o.detector;
     probe_options.max_shape_error = 0.95;
     vision::LampDetector probe(*cam, probe_prior(), probe_options);
-    std::vector<double> lengths, widths;
-    int rectangles = 0, discs = 0;
+    std::vector<LampLook> looks;
     const std::size_t step = std::max<std::size_t>(1, frames.size() / o.probe_frames);
     for (std::size_t i = 0; i < frames.size(); i += step) {
       try {
         const Image8 img = io::decode_image(frames[i]->value.data, source);
-        for (const auto& d : probe.detect(img).lamps) {
-          if (d.view != vision::LampView::full) continue;
-          lengths.push_back(d.length);
-          widths.push_back(d.width);
-          (d.length > 1.5 * d.width ? rectangles : discs) += 1;
-        }
+        for (const auto& d : probe.detect(img).lamps)
+          if (d.view == vision::LampView::full) looks.push_back({d.length, d.width});
       } catch (const std::exception&) {
         // an unreadable frame is counted in the full pass
       }
     }
-    if (lengths.empty())
+    if (looks.empty())
       throw JobFailed(source + ": no lamp was seen whole in " + std::to_string(frames.size()) +
                       " ceiling frames: there is nothing to map");
-    // The lamps of the most common kind give the prior (the detector knows one kind).
-    std::vector<double> ls, ws;
-    for (std::size_t k = 0; k < lengths.size(); ++k) {
-      const bool rect = lengths[k] > 1.5 * widths[k];
-      if (rect == (rectangles >= discs)) {
-        ls.push_back(lengths[k]);
-        ws.push_back(widths[k]);
-      }
-    }
-    out.prior.rectangle = rectangles >= discs;
-    out.prior.length = median(ls);
-    out.prior.width = out.prior.rectangle ? median(ws) : out.prior.length;
-    out.prior.min_distance = 0.7;  // lamps up to 30 % nearer or 40 % further than most
-    out.prior.nominal_distance = 1.0;
-    out.prior.max_distance = 1.4;
+    out.kinds = lamp_kinds(looks, o.kinds);
+    out.prior = out.kinds.front();
   }
 
-  // 2. Every frame through the detector (decoding and detecting on every core, a detector each),
-  // then, with the wheels in time order, the lamp SLAM.
+  // 2. Every frame through the detector (decoding and detecting on every core, a detector of
+  // each kind each), then, with the wheels in time order, the lamp SLAM.
   std::vector<std::vector<vision::LampDetection>> detected(frames.size());
   std::vector<char> unreadable(frames.size(), 0);
   for_each_index(
-      frames.size(), [&] { return vision::LampDetector(*cam, out.prior, o.detector); },
-      [&](vision::LampDetector& detector, std::size_t i) {
+      frames.size(),
+      [&] {
+        std::vector<vision::LampDetector> detectors;
+        for (const auto& kind : out.kinds) detectors.emplace_back(*cam, kind, o.detector);
+        return detectors;
+      },
+      [&](std::vector<vision::LampDetector>& detectors, std::size_t i) {
         try {
-          detected[i] = detector.detect(io::decode_image(frames[i]->value.data, source)).lamps;
+          detected[i] =
+              detect_kinds(detectors, out.kinds, io::decode_image(frames[i]->value.data, source));
         } catch (const std::exception&) {
           unreadable[i] = 1;
         }
@@ -463,10 +493,12 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
       mapper.ceiling(t, detected[i]);
     }
   };
+  MapBuildOptions learnt = o;
+  learnt.mapper.kinds = out.kinds;
   std::size_t base = 0;
   const std::vector<std::optional<Pose2>> carried_to =
-      place_parts(log, source, robot, o, starts, feed, frames, out.notes, base);
-  LampMapper mapper(robot, o.mapper);
+      place_parts(log, source, robot, learnt, starts, feed, frames, out.notes, base);
+  LampMapper mapper(robot, learnt.mapper);
   for (std::size_t p = base; p < parts; ++p) {
     if (p > base && !carried_to[p]) continue;
     if (p > base) mapper.carried(*carried_to[p]);

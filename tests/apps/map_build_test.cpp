@@ -44,6 +44,7 @@ struct Recorded {
 struct LampErrors {
   std::set<std::string> matched;             // true lamp ids
   std::map<std::string, std::string> built;  // the built lamp's id on each true one
+  std::map<std::string, double> error;       // m, on each true one, after the alignment
   double rms = 0, worst = 0;
 };
 
@@ -51,6 +52,7 @@ LampErrors lamp_errors(const graph::TopologicalMap& built, const graph::Topologi
                        const Pose2& start, double within_m = 0.3) {
   LampErrors e;
   std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> pairs;
+  std::vector<std::string> ids;  // the true lamp of each pair
   for (const auto& n : built.nodes()) {
     for (const auto& l : n.lamps) {
       const Eigen::Vector2d at = start.transform_from(l.xyz.head<2>());
@@ -63,12 +65,15 @@ LampErrors lamp_errors(const graph::TopologicalMap& built, const graph::Topologi
       if (!e.matched.insert(near.front()->id.value).second)
         ADD_FAILURE() << "twice: " << near.front()->id.value;
       pairs.emplace_back(l.xyz.head<2>(), near.front()->xyz.head<2>());
+      ids.push_back(near.front()->id.value);
     }
   }
   const Pose2 fit = mapping::fit_rigid(pairs);
   double sum = 0;
-  for (const auto& [b, t] : pairs) {
+  for (std::size_t k = 0; k < pairs.size(); ++k) {
+    const auto& [b, t] = pairs[k];
     const double err = (fit.transform_from(b) - t).norm();
+    e.error[ids[k]] = err;
     e.worst = std::max(e.worst, err);
     sum += err * err;
   }
@@ -392,7 +397,18 @@ TEST(MapBuild, ACarryPutDownBesideALampCutByTheBorderIsFound) {
     const LampErrors e = lamp_errors(built, graph::read_map(map).map, map_origin(recorded, r.err));
     EXPECT_EQ(built.lamp_count(), e.matched.size());  // none false, each once
     EXPECT_GE(e.matched.size(), 5u);
-    EXPECT_LE(e.worst, 0.05);
+    // The workshop's round lamp, of another kind than the corridors', is mapped too. Seen only
+    // from the drive's last two metres, after the turn through the door, its place rests on the
+    // wheels' heading through that turn: 7.3 cm off on seed 13 (3.2 cm on seed 1), past the 5 cm
+    // the corridors' lamps keep (docs/mapping.md, "Lamps of several kinds").
+    double corridors = 0;
+    for (const auto& [id, err] : e.error)
+      if (id.rfind("Workshop", 0) != 0) corridors = std::max(corridors, err);
+    EXPECT_LE(corridors, 0.05);
+    if (c.route == "E1 -> Workshop") {
+      ASSERT_EQ(e.error.count("Workshop-L1"), 1u);
+      EXPECT_LE(e.error.at("Workshop-L1"), 0.10);
+    }
   }
   fs::remove_all(dir);
 }
@@ -444,8 +460,8 @@ TEST(MapBuild, AWideAngleCeilingCameraCalibratedAsKannalaBrandtTracksAndMaps) {
 }
 
 // Carried out of the kitchen 12 s into Kitchen -> Lab 4: the drive before the carry saw only the
-// kitchen's lamps, of another kind, and maps none, so the drive's lamps start where the robot was
-// put down. A survey given where the drive started cannot use that start (it would put the drive
+// kitchen's lamp, too few to join the rest to, so the drive's lamps start where the robot was put
+// down. A survey given where the drive started cannot use that start (it would put the drive
 // where it never was): it says so and places the drive by its lamps, which find the office as
 // it is.
 TEST(MapBuild, ASurveyGivenTheStartOfADriveWhoseFirstPartMapsNoLampPlacesItByItsLamps) {
@@ -464,7 +480,7 @@ TEST(MapBuild, ASurveyGivenTheStartOfADriveWhoseFirstPartMapsNoLampPlacesItByIts
                                    "' --quiet --initial-pose " + std::to_string(start.x()) + "," +
                                    std::to_string(start.y()) + "," + std::to_string(start.yaw()));
   ASSERT_EQ(s.status, 0) << s.err;
-  EXPECT_THAT(s.err, HasSubstr("the drive before it mapped no lamp"));
+  EXPECT_THAT(s.err, HasSubstr("the drive before it mapped 1 lamp, too few to join the rest to"));
   EXPECT_THAT(s.err, HasSubstr("--initial-pose is where the drive started, which is not in the "
                                "drive's map"));
   EXPECT_THAT(s.out, HasSubstr("0 failed, 0 moved, 0 new"));

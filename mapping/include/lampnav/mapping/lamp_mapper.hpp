@@ -6,7 +6,8 @@
 // Front end: a keyframe every `keyframe_m` of travel; each lamp the detector saw whole is first
 // followed from the last keyframe across the image (`track_gate`), whatever its height; else it
 // is placed on the ceiling from the current estimate of the pose and joins the nearest landmark
-// of its kind within `gate_m`, or starts a new one, at the median solved height of its kind
+// of its kind (`kinds`) within `gate_m`, or starts a new one, at the median solved height of its
+// kind
 // (`height_guess_m` before the first solve). The pose estimate is the dead reckoning corrected by
 // the last solve, so a lamp seen again after a loop is placed with the loop's drift only since
 // then.
@@ -52,6 +53,13 @@ struct LampMapperOptions {
   double square_sigma = 0.01;  // rad, how square
   // Lamps of one kind hang at one height, within this (m; Huber beyond it). 0: each its own.
   double shared_height_sigma = 0.01;
+  // Lamps of several kinds under one ceiling: each kind's height held to the most common kind's
+  // within `kind_tie_sigma` while the two are at most `kind_tie_max_m` apart (a Tukey loss:
+  // kinds hung further apart, a hall's high lamps and a gallery's low ones, go free). A kind with
+  // one or two lamps, seen from one side at a drive's end, then takes the ceiling's height.
+  // 0: each kind its own.
+  double kind_tie_sigma = 0.01;
+  double kind_tie_max_m = 0.15;
   double huber_sigmas = 3.0;  // the camera terms' loss turns linear beyond this many sigmas
   int min_sightings = 5;      // a landmark seen at fewer keyframes is dropped (a glint)
   double merge_m = 0.3;       // landmarks of one kind this close after solving are one lamp
@@ -63,7 +71,11 @@ struct LampMapperOptions {
   // lamps both parts saw tie it to the rest (`LampMapper::carried`).
   double carry_sigma_m = 0.1;
   double carry_sigma_yaw = 0.03;  // rad
-  void validate() const;          // throws InputError naming the field
+  // The kinds of lamp the detector looks for, seen from unit distance (map_build learns them):
+  // a lamp seen whole is of the nearest kind of its shape, joins only landmarks of its kind, and
+  // shares its kind's height. Empty: two kinds, long lamps and round ones.
+  std::vector<vision::LampShapePrior> kinds;
+  void validate() const;  // throws InputError naming the field
 };
 
 // A lamp of the built map, in the map frame (the drive's start).

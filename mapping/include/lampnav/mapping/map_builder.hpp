@@ -11,6 +11,7 @@
 
 #include "lampnav/core/robot_description.hpp"
 #include "lampnav/graph/map.hpp"
+#include "lampnav/mapping/lamp_kinds.hpp"
 #include "lampnav/mapping/lamp_mapper.hpp"
 #include "lampnav/mapping/topology.hpp"
 #include "lampnav/vision/lamp_detector.hpp"
@@ -36,6 +37,7 @@ struct MapBuildOptions {
   TopologyOptions topology;
   vision::LampDetectorOptions detector;
   int probe_frames = 300;  // frames spread over the drive from which the lamps' look is learnt
+  LampKindOptions kinds;   // how the lamps' looks are told apart into kinds
   // At most this many omni frames, spread over the drive, are detected for the ways out it did
   // not take (TopologyOptions::way_min_lamps; 0: none; a robot without an omni camera has none).
   int omni_views_for_ways = 600;
@@ -61,7 +63,10 @@ struct MapBuildOptions {
 // The lamps of a recorded drive (the first half of a map build; a survey's whole input).
 struct DriveLamps {
   MappingResult mapped;
-  vision::LampShapePrior prior;  // learnt: the lamps' size seen from unit distance
+  // Learnt: the kinds of lamp, each its size seen from unit distance, the most common first
+  // (`prior`).
+  std::vector<vision::LampShapePrior> kinds;
+  vision::LampShapePrior prior;
   std::size_t frames = 0, unreadable_frames = 0, lamps_seen_whole = 0;
   double travel_m = 0;
   // The map's frame is the drive's start; false: where the robot was put down after a carry (the
