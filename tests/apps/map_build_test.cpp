@@ -399,7 +399,7 @@ TEST(MapBuild, ACarryPutDownBesideALampCutByTheBorderIsFound) {
     EXPECT_GE(e.matched.size(), 5u);
     // The workshop's round lamp, of another kind than the corridors', is mapped too. Seen only
     // from the drive's last two metres, after the turn through the door, its place rests on the
-    // wheels' heading through that turn: 7.3 cm off on seed 13 (3.2 cm on seed 1), past the 5 cm
+    // wheels' heading through that turn: 7.4 cm off on seed 13 (2.4 cm on seed 1), past the 5 cm
     // the corridors' lamps keep (docs/mapping.md, "Lamps of several kinds").
     double corridors = 0;
     for (const auto& [id, err] : e.error)
