@@ -57,27 +57,17 @@ struct SquareFactor {
 
 // Lamps of one kind hang at one height (a flat ceiling), robustly: a lamp the drive saw from
 // one side only, or while turning on the spot, borrows the height of its kind; one truly higher
-// pays a bounded price (Huber) and keeps its own.
+// pays a bounded price (Huber) and keeps its own. The same between two kinds' heights (`at` 0):
+// kinds under one ceiling.
 struct HeightFactor {
-  explicit HeightFactor(double sigma) : s(sigma) {}
+  explicit HeightFactor(double sigma, int at = 2) : s(sigma), i(at) {}
   template <class T>
   bool operator()(const T* lamp, const T* height, T* r) const {
-    r[0] = (lamp[2] - height[0]) / T(s);
+    r[0] = (lamp[i] - height[0]) / T(s);
     return true;
   }
   double s;
-};
-
-// Two kinds of lamp under one ceiling: their shared heights alike (a Tukey loss lets kinds hung
-// further apart go free).
-struct KindTie {
-  explicit KindTie(double sigma) : s(sigma) {}
-  template <class T>
-  bool operator()(const T* height, const T* other, T* r) const {
-    r[0] = (height[0] - other[0]) / T(s);
-    return true;
-  }
-  double s;
+  int i;  // the height's place in the first block
 };
 
 // The wheels differ little: d stays near 0.
@@ -219,9 +209,9 @@ SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
     // Each kind's height tied to the most common kind's (the first).
     for (std::size_t k = 1; k < kinds && o.kind_tie_sigma > 0; ++k)
       if (in_problem[k] && in_problem[0])
-        problem.AddResidualBlock(
-            new ceres::AutoDiffCostFunction<KindTie, 1, 1, 1>(new KindTie(o.kind_tie_sigma)),
-            &tie_loss, &kind_height[k], &kind_height[0]);
+        problem.AddResidualBlock(new ceres::AutoDiffCostFunction<HeightFactor, 1, 1, 1>(
+                                     new HeightFactor(o.kind_tie_sigma, 0)),
+                                 &tie_loss, &kind_height[k], &kind_height[0]);
   }
   bool any_rectangle = false;
   if (o.square_lamps) {
