@@ -201,6 +201,24 @@ const Node* TopologicalMap::node_containing(const Eigen::Vector2d& p) const {
   return found;
 }
 
+const Node* TopologicalMap::node_near(const Eigen::Vector2d& p, double margin) const {
+  if (const Node* n = node_containing(p)) return n;
+  if (!(margin > 0)) return nullptr;
+  const Node* found = nullptr;
+  double best = margin;
+  const Eigen::Vector2d m(margin, margin);
+  impl_->region_index.query(Box2{p - m, p + m}, [&](std::size_t v) {
+    const Node& n = impl_->g[v];
+    if (n.region.size() < 3) return;
+    const double d = n.region.distance_to_boundary(p);
+    if (d <= best) {
+      best = d;
+      found = &n;
+    }
+  });
+  return found;
+}
+
 std::vector<const Lamp*> TopologicalMap::lamps_in_walking_order(NodeId id, Travel travel) const {
   const Node& n = node(id);
   std::vector<const Lamp*> out;

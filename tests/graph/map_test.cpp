@@ -58,6 +58,29 @@ TEST(TopologicalMap, NodeContainingUsesRegionsNotNearestPoint) {
   EXPECT_EQ(m.node_containing(V(50, 50)), nullptr);
 }
 
+// Near a region: inside it, else the nearest region within the margin (a robot in the sliver
+// between two places, or a pose estimate centimetres off), else none.
+TEST(TopologicalMap, NodeNearTakesTheNearestRegionWithinTheMargin) {
+  TopologicalMap m("t");
+  Node a;
+  a.id = NodeId(1);
+  a.name = "A";
+  a.region = Polygon({{0, 0}, {2, 0}, {2, 1}, {0, 1}});
+  m.add_node(a);
+  Node b = a;
+  b.id = NodeId(2);
+  b.name = "B";
+  b.region = Polygon({{2.1, 0}, {4, 0}, {4, 1}, {2.1, 1}});  // 10 cm past A
+  m.add_node(b);
+  EXPECT_EQ(m.node_near({1, 0.5}, 0.2)->name, "A");
+  EXPECT_EQ(m.node_containing({2.03, 0.5}), nullptr);
+  EXPECT_EQ(m.node_near({2.03, 0.5}, 0.2)->name, "A");
+  EXPECT_EQ(m.node_near({2.08, 0.5}, 0.2)->name, "B");
+  EXPECT_EQ(m.node_near({2.03, 0.5}, 0.0), nullptr);
+  EXPECT_EQ(m.node_near({1, 1.25}, 0.2), nullptr);
+  EXPECT_EQ(m.node_near({1, 1.15}, 0.2)->name, "A");
+}
+
 TEST(TopologicalMap, LampsInWalkingOrderFollowTravel) {
   test::MapSketch s;
   s.corridor("C", V(0, 0), V(10, 0), {}, 2.5);

@@ -158,6 +158,10 @@ class TopologicalMap {
 
   // The node whose region contains p (regions may touch: the first added wins on a shared edge).
   const Node* node_containing(const Eigen::Vector2d& p) const;
+  // The node whose region contains p, else the one whose region is nearest within `margin` (m);
+  // null when none is. A robot is often a few centimetres outside every region (a built map's
+  // regions meet with slivers between them; a pose estimate is centimetres off).
+  const Node* node_near(const Eigen::Vector2d& p, double margin) const;
   // Lamps of a node in the order met when walking it that way (paper 2's lamp tags).
   std::vector<const Lamp*> lamps_in_walking_order(NodeId id, Travel travel) const;
   // The walking direction along a node's axis for a heading (rad); forward for nodes without one.
