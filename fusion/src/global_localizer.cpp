@@ -45,6 +45,7 @@ void GlobalLocalizerOptions::validate() const {
   check(p.noise_xy_m >= 0 && p.noise_yaw_deg >= 0, "paper.noise", "must not be negative");
   check(p.threshold_px > 0, "paper.threshold_px", "must be positive");
   const LampPairOptions& q = pairs;
+  check(q.graph_margin_m >= 0 && q.graph_margin_m <= 5, "pairs.graph_margin_m", "must be 0 to 5");
   check(q.seed_centroid_shift >= 0 && q.seed_centroid_shift <= 1, "pairs.seed_centroid_shift",
         "must be between 0 and 1");
   check(q.pair_max_theta_deg > 0 && q.pair_max_theta_deg < 90, "pairs.pair_max_theta_deg",

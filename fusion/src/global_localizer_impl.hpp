@@ -207,7 +207,9 @@ struct GlobalLocalizer::Impl {
   Impl(const graph::TopologicalMap& m, const CameraDescription& camera,
        const GlobalLocalizerOptions& opt);
 
-  const graph::Node* node_of(const Pose2& p) const { return map->node_containing(p.translation()); }
+  const graph::Node* node_of(const Pose2& p) const {
+    return map->node_near(p.translation(), o.pairs.graph_margin_m);
+  }
   // Hypotheses refined outside every node's region dropped (restrict_to_graph), the rest in order.
   void drop_outside_graph(std::vector<PoseHypothesis>& hs) const {
     if (!o.pairs.restrict_to_graph || !has_regions) return;

@@ -96,15 +96,7 @@ struct HypothesisSet::Impl {
   // Whether a pose stands in (or within the margin of) some node's region.
   bool inside(const Pose2& p) const {
     if (!has_regions) return true;
-    const Eigen::Vector2d c = p.translation();
-    if (map->node_containing(c)) return true;
-    const double m = o.wall_margin_m;
-    if (m <= 0) return false;
-    for (int k = 0; k < 8; ++k) {
-      const double a = k * M_PI / 4;
-      if (map->node_containing(c + m * Eigen::Vector2d(std::cos(a), std::sin(a)))) return true;
-    }
-    return false;
+    return map->node_near(p.translation(), o.wall_margin_m) != nullptr;
   }
 
   Hypothesis carried(const Hypothesis& h, Stamp t, const OdometryTrack& odo) const {
