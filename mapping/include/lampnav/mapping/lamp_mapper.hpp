@@ -61,7 +61,7 @@ struct LampMapperOptions {
   double kind_tie_sigma = 0.01;
   double kind_tie_max_m = 0.15;
   double huber_sigmas = 3.0;  // the camera terms' loss turns linear beyond this many sigmas
-  int min_sightings = 5;      // a landmark seen at fewer keyframes is dropped (a glint)
+  int min_sightings = 3;      // a landmark seen at fewer keyframes is dropped (a glint)
   double merge_m = 0.3;       // landmarks of one kind this close after solving are one lamp
   int max_iterations = 50;    // per solve
   // A lamp seen again after 20 m away joins its landmark (closing the loop). Off: it starts a
