@@ -53,6 +53,9 @@ void LampMapperOptions::validate() const {
   check(kind_tie_sigma >= 0, "kind_tie_sigma", "must not be negative");
   check(kind_tie_max_m > kind_tie_sigma, "kind_tie_max_m", "must be above kind_tie_sigma");
   check(min_sightings >= 1, "min_sightings", "must be at least 1");
+  check(min_sightings_near >= 1 && min_sightings_near <= min_sightings, "min_sightings_near",
+        "must be 1 to min_sightings");
+  check(placed_sigma_m > 0, "placed_sigma_m", "must be positive");
   check(merge_m >= 0 && merge_m < gate_m + 1, "merge_m", "must be 0 to the gate plus 1 m");
   check(max_iterations >= 1, "max_iterations", "must be at least 1");
   check(window_m > 0, "window_m", "must be positive");
@@ -282,6 +285,13 @@ struct LampMapper::Impl {
     learn_new_height();
   }
 
+  // The keyframes a landmark at height z must be seen at to be kept (LampMapperOptions).
+  int sightings_needed(double z) const {
+    const double each = (z - geometry.mount_origin().z()) * o.pixel_sigma_px / focal_px;
+    const double n = std::ceil(std::pow(std::max(0.0, each) / o.placed_sigma_m, 2));
+    return static_cast<int>(std::clamp(n, double(o.min_sightings_near), double(o.min_sightings)));
+  }
+
   // Each kind's median solved height, over the landmarks seen often enough to be kept.
   void learn_new_height() {
     for (std::size_t kind = 0; kind < new_height.size(); ++kind) {
@@ -363,7 +373,7 @@ MappingResult LampMapper::finish() {
   out.sightings = pb.sightings.size();
   for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
     if (into[i] >= 0) continue;
-    if (seen[i] < m.o.min_sightings) {
+    if (seen[i] < m.sightings_needed(pb.lamps[i][2])) {
       ++out.dropped;
       continue;
     }

@@ -61,9 +61,17 @@ struct LampMapperOptions {
   double kind_tie_sigma = 0.01;
   double kind_tie_max_m = 0.15;
   double huber_sigmas = 3.0;  // the camera terms' loss turns linear beyond this many sigmas
-  int min_sightings = 3;      // a landmark seen at fewer keyframes is dropped (a glint)
-  double merge_m = 0.3;       // landmarks of one kind this close after solving are one lamp
-  int max_iterations = 50;    // per solve
+  // A landmark is kept when seen at enough keyframes to place it within placed_sigma_m (each
+  // sighting places it to its height above the camera times pixel_sigma_px over the focal
+  // length), at least min_sightings_near and never more than min_sightings needed: under an
+  // office ceiling 3 (a corridor lamp seen whole only from a corner's turn, left out at 5, made
+  // a replay under it call the map contradicted), under one 8 m high 5 (one seen 3 times was
+  // 8 cm off). Fewer is a glint.
+  int min_sightings = 5;
+  int min_sightings_near = 3;
+  double placed_sigma_m = 0.015;
+  double merge_m = 0.3;     // landmarks of one kind this close after solving are one lamp
+  int max_iterations = 50;  // per solve
   // A lamp seen again after 20 m away joins its landmark (closing the loop). Off: it starts a
   // new one, as mapping without loop closure would (for comparison: docs/mapping.md).
   bool close_loops = true;
