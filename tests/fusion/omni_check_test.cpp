@@ -81,5 +81,55 @@ TEST(OmniCheck, OfficeTruthConsistentKidnapOftenInconsistent) {
   EXPECT_GE(away.inconsistent, 15);
 }
 
+// A map of part of the building (one drive's corridors: `map build`) against the view of the
+// whole building: the lamps of the corridors the map lacks are most of the blobs at a junction
+// or a corner. Blobs whose rays meet the ceiling beyond every place of the map say nothing, so
+// the robot is not called lost where it truly is (it was, at such a junction, and then fixed on
+// a wrong place 17 m off: docs/hypotheses.md). The price: on such a map the omni check alone
+// seldom catches a kidnap (the estimate turned a quarter: printed), the ceiling camera must.
+TEST(OmniCheck, LampsBeyondAMapOfPartOfTheBuildingDoNotCallTheTruthLost) {
+  const graph::TopologicalMap whole =
+      graph::read_map(test::source_path("maps/office_floor.geojson")).map;
+  graph::TopologicalMap part("part");
+  for (const char* name : {"J1", "C5", "J2"}) part.add_node(*whole.find_node(name));
+  const RobotDescription robot =
+      read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  const CameraDescription& cam = *robot.find_camera("omni_camera");
+  std::vector<const graph::Lamp*> lamps;
+  for (const auto& n : whole.nodes())
+    for (const auto& l : n.lamps) lamps.push_back(&l);
+  const sim::OmniRenderer renderer(cam, sim::OmniRenderOptions{});
+  vision::OmniLampDetector detector(cam);
+  const OmniCheck check(part, cam);
+  OmniCheckOptions counting;
+  counting.count_beyond_map = true;
+  const OmniCheck counts_them(part, cam, counting);
+  std::mt19937_64 rng(8);
+  std::uniform_real_distribution<double> u(0, 1);
+  const Eigen::Matrix3d P = Eigen::Vector3d(4e-4, 4e-4, 1e-4).asDiagonal();
+  int truth_lost = 0, truth_lost_counting = 0, truth_beyond = 0, away_lost = 0;
+  for (int k = 0; k < 30; ++k) {
+    const graph::Node& n = *part.find_node(k % 3 == 1 ? "C5" : k % 3 == 0 ? "J1" : "J2");
+    const Eigen::Vector2d at = n.axis ? n.axis->point_at(u(rng) * n.axis->length()) : n.point;
+    const Pose2 truth(at.x(), at.y(), 2 * M_PI * u(rng));
+    const Image8 img = renderer.render(truth, {0.0, 0.0}, lamps, rng);
+    const auto blobs = detector.detect(vision::ImageView::of(img)).blobs;
+    const OmniCheckResult r = check.check(truth, P, blobs);
+    truth_lost += r.conclusive && !r.consistent;
+    truth_beyond += r.beyond_map > 0;
+    const OmniCheckResult c = counts_them.check(truth, P, blobs);
+    truth_lost_counting += c.conclusive && !c.consistent;
+    // Kidnapped: the estimate turned a quarter (in a corridor, its lamps then cross the view).
+    const Pose2 away(truth.x(), truth.y(), truth.yaw() + M_PI / 2);
+    const OmniCheckResult a = check.check(away, P, blobs);
+    away_lost += a.conclusive && !a.consistent;
+  }
+  EXPECT_EQ(truth_lost, 0);
+  EXPECT_GE(truth_beyond, 10);
+  std::cout << "at the truth: " << truth_lost << " lost (" << truth_lost_counting
+            << " counting the blobs beyond the map); turned a quarter: " << away_lost << " lost\n";
+  EXPECT_GE(truth_lost_counting, 3) << "no view is lost counting them: the test shows nothing";
+}
+
 }  // namespace
 }  // namespace lampnav::fusion

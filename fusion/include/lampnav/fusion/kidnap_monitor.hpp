@@ -80,6 +80,9 @@ struct OmniCheckOptions {
   int min_expected = 3;              // fewer clear lamps predicted (and fewer blobs seen):
                                      // inconclusive
   double min_match_fraction = 0.5;   // below (for lamps, or for blobs): inconsistent
+  // Count the blobs no lamp explains whose rays meet the ceiling beyond every place of the map
+  // (off: they say nothing, as a map of part of a building says nothing there).
+  bool count_beyond_map = false;
   void validate() const;
 };
 
@@ -91,6 +94,8 @@ struct OmniCheckResult {
   int matched = 0;          // of those, with a blob in the expected direction (one-to-one)
   int blobs = 0;            // blobs in the used part of the view
   int explained_blobs = 0;  // of those, in the direction of some map lamp
+  int beyond_map = 0;       // blobs no map lamp explains whose ray meets the ceiling beyond
+                            // every place (left out of `blobs`: the map says nothing there)
   double match_fraction() const { return expected ? double(matched) / expected : 0.0; }
   double explained_fraction() const { return blobs ? double(explained_blobs) / blobs : 1.0; }
 };
@@ -111,6 +116,7 @@ class OmniCheck {
   Eigen::Vector3d mount_t_;
   OmniCheckOptions o_;
   std::vector<const graph::Lamp*> lamps_;
+  double lamp_height_ = 0;  // the lamps' median height, where a blob's ray meets the ceiling
   // The smallest a lamp's blob can be, per unit of cos(theta): half the smallest lamp size seen
   // from the highest lamp's height above the camera. A smaller blob is a spurious light.
   double min_blob_per_cos_ = 0;  // spurious_blobs.hpp
