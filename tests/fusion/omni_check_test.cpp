@@ -15,17 +15,26 @@ struct Tally {
   int consistent = 0, inconsistent = 0, inconclusive = 0;
 };
 
+// The pioneer's omni camera rendering a building's lamps, and its detector.
+struct Camera {
+  RobotDescription robot = read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  const CameraDescription& cam = *robot.find_camera("omni_camera");
+  const sim::OmniRenderer renderer{cam, sim::OmniRenderOptions{}};
+  vision::OmniLampDetector detector{cam};
+  std::vector<vision::OmniBlob> blobs(const graph::TopologicalMap& building, const Pose2& pose,
+                                      const sim::CameraTilt& tilt, std::mt19937_64& rng) {
+    std::vector<const graph::Lamp*> lamps;
+    for (const auto& n : building.nodes())
+      for (const auto& l : n.lamps) lamps.push_back(&l);
+    const Image8 img = renderer.render(pose, tilt, lamps, rng);
+    return detector.detect(vision::ImageView::of(img)).blobs;
+  }
+};
+
 std::pair<Tally, Tally> check_map(const std::string& map_file, std::uint64_t seed) {
   const graph::TopologicalMap map = graph::read_map(test::source_path(map_file)).map;
-  const RobotDescription robot =
-      read_robot_description(test::source_path("maps/robots/pioneer.json"));
-  const CameraDescription& cam = *robot.find_camera("omni_camera");
-  std::vector<const graph::Lamp*> lamps;
-  for (const auto& n : map.nodes())
-    for (const auto& l : n.lamps) lamps.push_back(&l);
-  const sim::OmniRenderer renderer(cam, sim::OmniRenderOptions{});
-  vision::OmniLampDetector detector(cam);
-  const OmniCheck check(map, cam);
+  Camera camera;
+  const OmniCheck check(map, camera.cam);
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);
   std::normal_distribution<double> bump(0, 0.5 * M_PI / 180);
@@ -47,8 +56,7 @@ std::pair<Tally, Tally> check_map(const std::string& map_file, std::uint64_t see
     const graph::Node& n = *lit[rng() % lit.size()];
     const Pose2 truth(n.point.x() + 0.5 * (u(rng) - 0.5), n.point.y() + 0.5 * (u(rng) - 0.5),
                       2 * M_PI * u(rng));
-    const Image8 img = renderer.render(truth, {bump(rng), bump(rng)}, lamps, rng);
-    const auto blobs = detector.detect(vision::ImageView::of(img)).blobs;
+    const auto blobs = camera.blobs(map, truth, {bump(rng), bump(rng)}, rng);
     tally(check.check(truth, P, blobs), at_truth);
     const double a = 2 * M_PI * u(rng);
     const Pose2 away(truth.x() + 4 * std::cos(a), truth.y() + 4 * std::sin(a),
@@ -92,18 +100,11 @@ TEST(OmniCheck, LampsBeyondAMapOfPartOfTheBuildingDoNotCallTheTruthLost) {
       graph::read_map(test::source_path("maps/office_floor.geojson")).map;
   graph::TopologicalMap part("part");
   for (const char* name : {"J1", "C5", "J2"}) part.add_node(*whole.find_node(name));
-  const RobotDescription robot =
-      read_robot_description(test::source_path("maps/robots/pioneer.json"));
-  const CameraDescription& cam = *robot.find_camera("omni_camera");
-  std::vector<const graph::Lamp*> lamps;
-  for (const auto& n : whole.nodes())
-    for (const auto& l : n.lamps) lamps.push_back(&l);
-  const sim::OmniRenderer renderer(cam, sim::OmniRenderOptions{});
-  vision::OmniLampDetector detector(cam);
-  const OmniCheck check(part, cam);
+  Camera camera;
+  const OmniCheck check(part, camera.cam);
   OmniCheckOptions counting;
   counting.count_beyond_map = true;
-  const OmniCheck counts_them(part, cam, counting);
+  const OmniCheck counts_them(part, camera.cam, counting);
   std::mt19937_64 rng(8);
   std::uniform_real_distribution<double> u(0, 1);
   const Eigen::Matrix3d P = Eigen::Vector3d(4e-4, 4e-4, 1e-4).asDiagonal();
@@ -112,8 +113,7 @@ TEST(OmniCheck, LampsBeyondAMapOfPartOfTheBuildingDoNotCallTheTruthLost) {
     const graph::Node& n = *part.find_node(k % 3 == 1 ? "C5" : k % 3 == 0 ? "J1" : "J2");
     const Eigen::Vector2d at = n.axis ? n.axis->point_at(u(rng) * n.axis->length()) : n.point;
     const Pose2 truth(at.x(), at.y(), 2 * M_PI * u(rng));
-    const Image8 img = renderer.render(truth, {0.0, 0.0}, lamps, rng);
-    const auto blobs = detector.detect(vision::ImageView::of(img)).blobs;
+    const auto blobs = camera.blobs(whole, truth, {0.0, 0.0}, rng);
     const OmniCheckResult r = check.check(truth, P, blobs);
     truth_lost += r.conclusive && !r.consistent;
     truth_beyond += r.beyond_map > 0;
