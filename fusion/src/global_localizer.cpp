@@ -13,6 +13,7 @@
 #include <sstream>
 #include <utility>
 
+#include "ceiling_rays.hpp"
 #include "global_localizer_impl.hpp"
 #include "lampnav/core/error.hpp"
 #include "spurious_blobs.hpp"
@@ -96,12 +97,10 @@ void GlobalLocalizer::Impl::index_lamps() {
   const LampPairOptions& q = o.pairs;
   std::map<std::pair<long, long>, int> class_ids;
   max_height = 0;
-  std::vector<double> heights;
   for (std::size_t i = 0; i < lamps.size(); ++i) {
     lamp_index[lamps[i]] = static_cast<int>(i);
     const double h = lamps[i]->xyz.z() - mount_t.z();
     max_height = std::max(max_height, h);
-    heights.push_back(h);
     const std::pair<long, long> key{std::lround(h / 0.05), std::lround(lamps[i]->length / 0.05)};
     auto it = class_ids.find(key);
     if (it == class_ids.end()) {
@@ -110,10 +109,7 @@ void GlobalLocalizer::Impl::index_lamps() {
     }
     class_of.push_back(it->second);
   }
-  if (!heights.empty()) {
-    std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
-    usual_height = heights[heights.size() / 2];
-  }
+  usual_height = detail::usual_lamp_height(*map, mount_t.z());
   spurious_limit = spurious_blob_limit(*map, mount_t.z());
   // Two seeds lie within pair_max_theta of the axis: no further apart than twice that reach.
   const double offset = mount_t.head<2>().norm();
@@ -203,13 +199,12 @@ std::vector<StraySighting> GlobalLocalizer::Impl::stray_sightings(
   if (!(usual_height > 0)) return out;
   const double tilt = o.pairs.tilt_sigma_deg * kDeg, yaw = 1.0 * kDeg;
   for (const int j : e.strays) {
-    const Vector3d d = mount_R * blobs[j].ray;  // level floor
-    if (!(d.z() > 0.01)) continue;              // below or at the lamps' horizon
-    const double t = usual_height / d.z();
-    const Vector3d base = mount_t + t * d;
-    const double distance = t * d.head<2>().norm(), slant = distance / usual_height;
+    const std::optional<Vector3d> base =
+        detail::ceiling_point(mount_R, mount_t, blobs[j].ray, usual_height);
+    if (!base) continue;  // below or at the lamps' horizon
+    const double distance = (*base - mount_t).head<2>().norm(), slant = distance / usual_height;
     const double reach = 3 * (tilt * usual_height * (1 + slant * slant) + yaw * distance);
-    out.push_back({pose.transform_from(base.head<2>()), reach});
+    out.push_back({pose.transform_from(base->head<2>()), reach});
   }
   return out;
 }

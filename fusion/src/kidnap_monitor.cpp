@@ -1,5 +1,6 @@
 #include "lampnav/fusion/kidnap_monitor.hpp"
 
+#include "ceiling_rays.hpp"
 #include "spurious_blobs.hpp"
 
 #include <algorithm>
@@ -50,20 +51,13 @@ OmniCheck::OmniCheck(const graph::TopologicalMap& map, const CameraDescription& 
       mount_R_(camera.mount.rotation()),
       mount_t_(camera.mount.xyz),
       o_(options),
+      lamp_height_(detail::usual_lamp_height(map, camera.mount.xyz.z())),
       min_blob_per_cos_(detail::spurious_blob_limit(map, camera.mount.xyz.z())) {
   o_.validate();
-  std::vector<double> heights;
   if (!is_fisheye(camera.model))
     throw Error("the omni check needs a fisheye camera, '" + camera.name + "' is not");
   for (const auto& n : map.nodes())
-    for (const auto& l : n.lamps) {
-      lamps_.push_back(&l);
-      heights.push_back(l.xyz.z());
-    }
-  if (!heights.empty()) {
-    std::nth_element(heights.begin(), heights.begin() + heights.size() / 2, heights.end());
-    lamp_height_ = heights[heights.size() / 2];
-  }
+    for (const auto& l : n.lamps) lamps_.push_back(&l);
 }
 
 OmniCheckResult OmniCheck::check(const Pose2& pose, const Eigen::Matrix3d& P,
@@ -121,11 +115,9 @@ OmniCheckResult OmniCheck::check(const Pose2& pose, const Eigen::Matrix3d& P,
     return false;
   };
   const auto in_map = [&](const vision::OmniBlob& b) {
-    const Vector3d d = mount_R_ * b.ray;  // level floor
-    if (!(d.z() > 0.01) || !(lamp_height_ > mount_t_.z())) return true;
-    const double t = (lamp_height_ - mount_t_.z()) / d.z();
-    const Vector3d base = mount_t_ + t * d;
-    return map_->node_containing(pose.transform_from(base.head<2>())) != nullptr;
+    const std::optional<Vector3d> base =
+        detail::ceiling_point(mount_R_, mount_t_, b.ray, lamp_height_);
+    return !base || map_->node_containing(pose.transform_from(base->head<2>())) != nullptr;
   };
   std::vector<const vision::OmniBlob*> used;
   for (const auto& b : blobs) {

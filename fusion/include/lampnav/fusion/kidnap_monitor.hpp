@@ -116,7 +116,8 @@ class OmniCheck {
   Eigen::Vector3d mount_t_;
   OmniCheckOptions o_;
   std::vector<const graph::Lamp*> lamps_;
-  double lamp_height_ = 0;  // the lamps' median height, where a blob's ray meets the ceiling
+  double lamp_height_ = 0;  // the median lamp's above the camera, where a blob's ray meets the
+                            // ceiling
   // The smallest a lamp's blob can be, per unit of cos(theta): half the smallest lamp size seen
   // from the highest lamp's height above the camera. A smaller blob is a spurious light.
   double min_blob_per_cos_ = 0;  // spurious_blobs.hpp
