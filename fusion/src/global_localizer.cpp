@@ -196,16 +196,8 @@ Vector3d GlobalLocalizer::Impl::CameraView::point(const Vector3d& lamp) const {
 std::vector<StraySighting> GlobalLocalizer::Impl::stray_sightings(
     const Pose2& pose, const Evaluation& e, const std::vector<BlobRay>& blobs) const {
   std::vector<StraySighting> out;
-  if (!(usual_height > 0)) return out;
-  const double tilt = o.pairs.tilt_sigma_deg * kDeg, yaw = 1.0 * kDeg;
-  for (const int j : e.strays) {
-    const std::optional<Vector3d> base =
-        detail::ceiling_point(mount_R, mount_t, blobs[j].ray, usual_height);
-    if (!base) continue;  // below or at the lamps' horizon
-    const double distance = (*base - mount_t).head<2>().norm(), slant = distance / usual_height;
-    const double reach = 3 * (tilt * usual_height * (1 + slant * slant) + yaw * distance);
-    out.push_back({pose.transform_from(base->head<2>()), reach});
-  }
+  for (const int j : e.strays)
+    if (const std::optional<StraySighting> s = sighting(pose, blobs[j].ray)) out.push_back(*s);
   return out;
 }
 

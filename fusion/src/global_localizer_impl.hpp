@@ -7,10 +7,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <unordered_map>
 #include <utility>
 #include <vector>
 
+#include "ceiling_rays.hpp"
 #include "flat_grid.hpp"
 #include "lampnav/fusion/global_localizer.hpp"
 #include "lampnav/fusion/merit.hpp"
@@ -241,6 +243,20 @@ struct GlobalLocalizer::Impl {
   };
 
   std::vector<BlobRay> blob_rays(const vision::OmniDetection& d, double max_theta) const;
+  // Where a blob's `ray` (camera frame) would put a lamp at the usual height, seen from `pose`;
+  // none at or below the lamps' horizon.
+  std::optional<StraySighting> sighting(const Pose2& pose, const Vector3d& ray) const {
+    if (!(usual_height > 0)) return std::nullopt;
+    const std::optional<Vector3d> base = detail::ceiling_point(mount_R, mount_t, ray, usual_height);
+    if (!base) return std::nullopt;
+    const double tilt = o.pairs.tilt_sigma_deg * detail::kDeg, yaw = 1.0 * detail::kDeg;
+    const double distance = (*base - mount_t).head<2>().norm(), slant = distance / usual_height;
+    StraySighting s;
+    s.at = pose.transform_from(base->head<2>());
+    s.reach = 3 * (tilt * usual_height * (1 + slant * slant) + yaw * distance);
+    s.beyond_map = has_regions && map->node_near(s.at, s.reach) == nullptr;
+    return s;
+  }
   // Where the blobs no lamp explains would put a lamp at the usual height, seen from `pose`.
   std::vector<StraySighting> stray_sightings(const Pose2& pose, const Evaluation& e,
                                              const std::vector<BlobRay>& blobs) const;

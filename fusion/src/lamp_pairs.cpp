@@ -245,7 +245,7 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
     int misses = 0;
     const double c = std::cos(pose.yaw()), s = std::sin(pose.yaw());
     for (std::size_t j = 0; j < ns && misses <= allowed_misses; ++j) {
-      bool on_lamp = false;
+      bool on_lamp = false, beyond = has_regions && !q.count_beyond_map;
       for (std::size_t cl = 0; cl < nc && !on_lamp; ++cl) {
         const double sg = seeds.sigma[j * nc + cl];
         if (sg < 0) continue;
@@ -254,8 +254,10 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
             pose.translation() + Vector2d(c * b.x() - s * b.y(), s * b.x() + c * b.y());
         const double r = 3 * sg + 0.3;
         on_lamp = lamp_of_class_within(w, r, int(cl));
+        beyond = beyond && !on_lamp && map->node_near(w, r) == nullptr;
       }
-      if (!on_lamp) ++misses;
+      // A seed beyond every place of the map is a lamp the map cannot have: no miss.
+      if (!on_lamp && !beyond) ++misses;
     }
     if (misses > allowed_misses) return;
     // Screened on the lamps the camera places well (screen_max_theta_deg): the seeds' and their
@@ -328,16 +330,29 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   // of the true pose more than the birth margin on the wide view (33 against 7 with the tilt,
   // on a 1,000-node kidnap). When the best candidate, refined with the tilt, finds the floor
   // tilted, every candidate is scored again holding that tilt, so that they compare.
+  Tilt tilt;
   if (can_be_complete && !refined.empty()) {
     std::size_t b = 0;
     for (std::size_t k = 1; k < refined.size(); ++k)
       if (refined[k].score < refined[b].score) b = k;
-    Tilt tilt;
     refine(refined[b].pose, 0.1, 1 * kDeg, blobs, 3, true, {}, &tilt);
     if (tilt.roll != 0 || tilt.pitch != 0)
       for_each_costly_index(refined.size(), serial_up_to(2), [&](std::size_t k) {
         refined[k] = refine(scored[k].pose, 0.3, 3 * kDeg, blobs, 1, false, tilt);
       });
+  }
+  // A candidate whose refinement left the tolerance its matching assumed (0.3 m, 3 degrees) may
+  // have matched some blob to another lamp than the truth's: refined again from it with a tight
+  // tolerance, both kept (refine_moved_again), holding the floor's tilt the others were held at.
+  if (q.refine_moved_again) {
+    const std::size_t first_pass = refined.size();
+    std::vector<std::size_t> moved;
+    for (std::size_t k = 0; k < first_pass; ++k)
+      if (distinct(refined[k].pose, scored[k].pose, 0.3, 3.0)) moved.push_back(k);
+    refined.resize(first_pass + moved.size());
+    for_each_costly_index(moved.size(), serial_up_to(2), [&](std::size_t i) {
+      refined[first_pass + i] = refine(scored[moved[i]].pose, 0.1, 1 * kDeg, blobs, 1, false, tilt);
+    });
   }
   drop_outside_graph(refined);
   // The plausible ones (within the ambiguity margin of the best, 32 at most) refined in full,

@@ -99,6 +99,19 @@ struct LampPairOptions {
   // set's margin) the wider search was incomplete more often on the imperfect-map bench and one
   // start more was fixed wrong there; at 0.15 m no bench has a wrong fix more.
   double graph_margin_m = 0.15;
+  // A candidate whose refinement ends farther from it than the tolerance its lamps were matched
+  // with (0.3 m, 3 degrees) is refined again from where it was, with a tight tolerance, and both
+  // are kept. With a cell's tolerance
+  // the first matching may pair a blob with the wrong lamp: where the map has few lamps, the
+  // truth's own candidate went 0.9 m and 12 degrees to a pose that scored as well as the truth,
+  // and the search called it the only place the image fits (a map of part of the office,
+  // docs/hypotheses.md).
+  bool refine_moved_again = true;
+  // Whether a seed whose lamp would lie beyond every place of the map counts as off its lamp
+  // (true) or says nothing of the pose (false). At the end of a map of part of a building, most
+  // seeds may be lamps the map cannot have: counted, they dropped the true pose before it was
+  // scored (docs/hypotheses.md).
+  bool count_beyond_map = false;
 };
 
 struct GlobalLocalizerOptions {
@@ -122,8 +135,9 @@ struct LampMatch {
 // a lamp the map lacks would be.
 struct StraySighting {
   Eigen::Vector2d at = Eigen::Vector2d::Zero();
-  double reach = 0;  // how far off `at` it may be (m): the floor's tilt and the pose's yaw
-                     // through the ray's slope, three sigmas
+  double reach = 0;         // how far off `at` it may be (m): the floor's tilt and the pose's yaw
+                            // through the ray's slope, three sigmas
+  bool beyond_map = false;  // farther than `reach` from every place of the map
 };
 
 struct PoseHypothesis {
