@@ -129,8 +129,11 @@ struct HypothesisSet::Impl {
     return std::sqrt(std::max(P(0, 0), P(1, 1)));
   }
 
-  // Whether an omni stray places its lamp well enough to be charged to a spot.
-  bool placed(const StraySighting& b) const { return b.reach <= o.stray_reach_max_m; }
+  // Whether an omni stray places its lamp well enough to be charged to a spot: near enough, and
+  // within the map's places unless count_beyond_map.
+  bool placed(const StraySighting& b) const {
+    return b.reach <= o.stray_reach_max_m && (o.count_beyond_map || !b.beyond_map);
+  }
   int placed_strays(const std::vector<StraySighting>& strays) const {
     return static_cast<int>(std::count_if(strays.begin(), strays.end(),
                                           [&](const StraySighting& b) { return placed(b); }));
