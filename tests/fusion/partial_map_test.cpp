@@ -1,11 +1,12 @@
-// Global localization on a map of part of a building: the map `lampnav map build` made of the
-// drive Office 1 -> Lab 3 of the bundled office (seed 5, placed on the office by its lamps), the
-// whole office rendered. Its first places hold two lamps, and the omni camera sees a dozen lamps
-// there that the map lacks.
+// Global localization and the hypothesis set on a map of part of a building: the map that
+// `lampnav map build` made of the drive Office 1 -> Lab 3 of the bundled office (seed 5, placed
+// on the office by its lamps), the whole office rendered. Its first places hold two lamps, and
+// the omni camera sees a dozen lamps there that the map lacks.
 
 #include <random>
 
 #include "lampnav/fusion/global_localizer.hpp"
+#include "lampnav/fusion/hypothesis_set.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/sim/renderers.hpp"
 #include "lampnav/vision/omni_detector.hpp"
@@ -90,6 +91,53 @@ TEST(PartialMap, ACompleteSearchHoldsTheTruthWhereTheMapHasFewLamps) {
   EXPECT_LE(lost_now, 4);
   EXPECT_GE(lost_once, lost_now + 4) << "refining again changed nothing: the test shows nothing";
   EXPECT_GE(lost_counted, lost_now + 1) << "seeds beyond the map changed nothing";
+}
+
+// At the corridor over Office 1's door, where the built map ends (the office's corridor goes on
+// 8 m west beyond it): the omni camera sees lamps there that the map cannot have. The hypothesis
+// at the truth is charged for them in the far account, bounded over all frames, not a spot each
+// as for a lamp seen inside the map's places (count_beyond_map).
+TEST(PartialMap, LampsBeyondTheMapCostTheTruthOneBoundedAccount) {
+  const PartialOffice o;
+  const GlobalLocalizer omni(o.built, o.cam());
+  const Pose2 truth(9.9942, 9.3800, 1.5921);
+  struct Charged {
+    bool found = false;
+    std::size_t spots = 0;
+    double total = 0, far = 0;
+  };
+  const auto charged = [&](bool count_beyond_map) {
+    HypothesisSetOptions opt;
+    opt.count_beyond_map = count_beyond_map;
+    HypothesisSet set(o.built, nullptr, &omni, CeilingPipelineOptions{}, opt);
+    OdometryTrack odometry(0.2);
+    Stamp t{};
+    for (int k = 0; k < 6; ++k) {
+      t += std::chrono::seconds(1);
+      odometry.add(t, 0, 0);
+      set.omni(t, o.view(truth, 600 + k), odometry);
+    }
+    Charged c;
+    for (const Hypothesis& h : set.hypotheses())
+      if ((h.pose.translation() - truth.translation()).norm() < 0.3) {
+        c.found = true;
+        c.spots = h.map_costs.strays.size();
+        c.far = h.map_costs.far_strays;
+        c.total = c.far;
+        for (const auto& s : h.map_costs.strays) c.total += s.spent;
+      }
+    return c;
+  };
+  const Charged beyond_far = charged(false), each_a_spot = charged(true);
+  std::cout << "lamps beyond the map: " << beyond_far.spots << " spots, " << beyond_far.total
+            << " in all (far " << beyond_far.far << "); counted as spots: " << each_a_spot.spots
+            << " spots, " << each_a_spot.total << " in all\n";
+  ASSERT_TRUE(beyond_far.found && each_a_spot.found);
+  EXPECT_LE(beyond_far.far, HypothesisSetOptions{}.far_stray_cost_max);
+  EXPECT_EQ(beyond_far.spots, 0u);
+  EXPECT_GE(each_a_spot.spots, 2u);
+  // More than one lamp the map lacks costs (unmapped_lamp_cost) saved.
+  EXPECT_GT(each_a_spot.total - beyond_far.total, HypothesisSetOptions{}.unmapped_lamp_cost);
 }
 
 }  // namespace
