@@ -254,7 +254,6 @@ struct GlobalLocalizer::Impl {
     StraySighting s;
     s.at = pose.transform_from(base->head<2>());
     s.reach = 3 * (tilt * usual_height * (1 + slant * slant) + yaw * distance);
-    s.beyond_map = has_regions && map->node_near(s.at, s.reach) == nullptr;
     return s;
   }
   // Where the blobs no lamp explains would put a lamp at the usual height, seen from `pose`.

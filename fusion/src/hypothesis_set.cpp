@@ -130,9 +130,12 @@ struct HypothesisSet::Impl {
   }
 
   // Whether an omni stray places its lamp well enough to be charged to a spot: near enough, and
-  // within the map's places unless count_beyond_map.
+  // within its reach of one of the map's places unless count_beyond_map. (Asked only of the near
+  // ones: a far stray's reach spans many places, and the search through them cost as much as
+  // weighing the hypothesis.)
   bool placed(const StraySighting& b) const {
-    return b.reach <= o.stray_reach_max_m && (o.count_beyond_map || !b.beyond_map);
+    return b.reach <= o.stray_reach_max_m &&
+           (o.count_beyond_map || map->node_near(b.at, b.reach) != nullptr);
   }
   int placed_strays(const std::vector<StraySighting>& strays) const {
     return static_cast<int>(std::count_if(strays.begin(), strays.end(),

@@ -135,9 +135,8 @@ struct LampMatch {
 // a lamp the map lacks would be.
 struct StraySighting {
   Eigen::Vector2d at = Eigen::Vector2d::Zero();
-  double reach = 0;         // how far off `at` it may be (m): the floor's tilt and the pose's yaw
-                            // through the ray's slope, three sigmas
-  bool beyond_map = false;  // farther than `reach` from every place of the map
+  double reach = 0;  // how far off `at` it may be (m): the floor's tilt and the pose's yaw
+                     // through the ray's slope, three sigmas
 };
 
 struct PoseHypothesis {

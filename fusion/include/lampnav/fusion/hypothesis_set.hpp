@@ -115,11 +115,12 @@ struct HypothesisSetOptions {
   // lamps seen near, and lamps the map has and the image lacks, still do.
   double far_stray_cost_max = 9.2;
   // Whether an omni blob no lamp explains, whose lamp would lie beyond every place of the map
-  // (StraySighting::beyond_map), is charged to a spot like the others (true) or to the far
-  // account (false). A map built from one drive holds the corridors the drive took: at its ends
-  // the building goes on, and the truth sees lamps there in every image. Charged a spot each,
-  // they made poses whose other end of the map explains them likelier than the truth (a map of
-  // part of the office, docs/hypotheses.md). Beyond a whole building's places no lamp is seen.
+  // (farther than its StraySighting::reach from each), is charged to a spot like the others
+  // (true) or to the far account (false). A map built from one drive holds the corridors the drive
+  // took: at its ends the building goes on, and the truth sees lamps there in every image. Charged
+  // a spot each, they made poses whose other end of the map explains them likelier than the truth
+  // (a map of part of the office, docs/hypotheses.md). Beyond a whole building's places no lamp is
+  // seen.
   bool count_beyond_map = false;
   // How far the map's lamps may be off the building's (m), in the set's labelling and pose fits:
   // `map build` leaves 2 to 4 cm (docs/mapping.md). The tracking filter keeps the ceiling
