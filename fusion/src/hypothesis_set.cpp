@@ -158,12 +158,15 @@ struct HypothesisSet::Impl {
     const double stray = omni->options().pairs.spurious_cost;
     double delta = detail::charge_absences(h.map_costs.lamps, missed, each, o.lamp_out_cost) -
                    each * static_cast<double>(missed.size());
+    int spots = 0;  // placed() asks the map: once a stray
     for (const StraySighting& b : strays)
-      if (placed(b))
+      if (placed(b)) {
+        ++spots;
         delta += detail::charge_stray(h.map_costs.strays, b.at, std::max(o.stray_radius_m, b.reach),
                                       stray, o.unmapped_lamp_cost) -
                  stray;
-    const double far = far_cost(unexplained, strays);
+      }
+    const double far = stray * std::max(0, unexplained - spots);  // as far_cost()
     delta += detail::charge_account(h.map_costs.far_strays, far, o.far_stray_cost_max) - far;
     for (const auto& [l, c] : lamp_costs)
       delta += detail::charge_misfit(h.map_costs.misfits, l, c, o.lamp_out_cost) - c;

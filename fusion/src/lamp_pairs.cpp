@@ -319,12 +319,14 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
   // (not four times as many, nor scored again with the floor's tilt, below). Those searches
   // were two thirds of the enumerations' time on the 100-node kidnaps (docs/hypotheses.md).
   const bool can_be_complete = ns >= 3 && in_reach <= limit;
+  // A candidate's lamps are matched within its cell's reach: a coarse pose is up to a cell off.
+  constexpr double cell_m = 0.3, cell_deg = 3.0;
   // One round each, at a level floor: enough to rank the candidates; the hypothesis set refines
   // in full.
   std::vector<PoseHypothesis> refined(
       std::min(in_reach, can_be_complete ? limit : std::size_t(cap)));
   for_each_costly_index(refined.size(), serial_up_to(2), [&](std::size_t k) {
-    refined[k] = refine(scored[k].pose, 0.3, 3 * kDeg, blobs, 1, false);
+    refined[k] = refine(scored[k].pose, cell_m, cell_deg * kDeg, blobs, 1, false);
   });
   // A floor bump tilts the camera alike whatever the pose, and a degree of it costs a level fit
   // of the true pose more than the birth margin on the wide view (33 against 7 with the tilt,
@@ -338,17 +340,17 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
     refine(refined[b].pose, 0.1, 1 * kDeg, blobs, 3, true, {}, &tilt);
     if (tilt.roll != 0 || tilt.pitch != 0)
       for_each_costly_index(refined.size(), serial_up_to(2), [&](std::size_t k) {
-        refined[k] = refine(scored[k].pose, 0.3, 3 * kDeg, blobs, 1, false, tilt);
+        refined[k] = refine(scored[k].pose, cell_m, cell_deg * kDeg, blobs, 1, false, tilt);
       });
   }
-  // A candidate whose refinement left the tolerance its matching assumed (0.3 m, 3 degrees) may
+  // A candidate whose refinement left the tolerance its matching assumed (its cell's) may
   // have matched some blob to another lamp than the truth's: refined again from it with a tight
   // tolerance, both kept (refine_moved_again), holding the floor's tilt the others were held at.
   if (q.refine_moved_again) {
     const std::size_t first_pass = refined.size();
     std::vector<std::size_t> moved;
     for (std::size_t k = 0; k < first_pass; ++k)
-      if (distinct(refined[k].pose, scored[k].pose, 0.3, 3.0)) moved.push_back(k);
+      if (distinct(refined[k].pose, scored[k].pose, cell_m, cell_deg)) moved.push_back(k);
     refined.resize(first_pass + moved.size());
     for_each_costly_index(moved.size(), serial_up_to(2), [&](std::size_t i) {
       refined[first_pass + i] = refine(scored[moved[i]].pose, 0.1, 1 * kDeg, blobs, 1, false, tilt);

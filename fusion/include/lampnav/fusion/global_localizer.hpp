@@ -101,11 +101,10 @@ struct LampPairOptions {
   double graph_margin_m = 0.15;
   // A candidate whose refinement ends farther from it than the tolerance its lamps were matched
   // with (0.3 m, 3 degrees) is refined again from where it was, with a tight tolerance, and both
-  // are kept. With a cell's tolerance
-  // the first matching may pair a blob with the wrong lamp: where the map has few lamps, the
-  // truth's own candidate went 0.9 m and 12 degrees to a pose that scored as well as the truth,
-  // and the search called it the only place the image fits (a map of part of the office,
-  // docs/hypotheses.md).
+  // are kept. With a cell's tolerance the first matching may pair a blob with the wrong lamp:
+  // where the map has few lamps, the truth's own candidate went 0.9 m and 12 degrees to a pose
+  // that scored as well as the truth, and the search called it the only place the image fits (a
+  // map of part of the office, docs/hypotheses.md).
   bool refine_moved_again = true;
   // Whether a seed whose lamp would lie beyond every place of the map counts as off its lamp
   // (true) or says nothing of the pose (false). At the end of a map of part of a building, most
