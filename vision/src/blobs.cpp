@@ -1,7 +1,6 @@
 #include "blobs.hpp"
 
 #include <algorithm>
-#include <cstring>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -63,17 +62,14 @@ void BlobLabeller::label(const ImageView& g, std::uint8_t t) {
 }
 
 void BlobLabeller::label(const ImageView& g, std::uint8_t t, const PixelBox& requested) {
-  box_ = {std::max(requested.u0, 0), std::max(requested.v0, 0), std::min(requested.u1, g.width - 1),
-          std::min(requested.v1, g.height - 1)};
+  const PixelBox box{std::max(requested.u0, 0), std::max(requested.v0, 0),
+                     std::min(requested.u1, g.width - 1), std::min(requested.v1, g.height - 1)};
   runs_.clear();
   blobs_.clear();
   sorted_.clear();
-  width_ = 0;
-  binary_filled_ = false;
-  if (box_.empty()) return;
-  const int w = box_.u1 - box_.u0 + 1, h = box_.v1 - box_.v0 + 1;
-  const int du = box_.u0, dv = box_.v0;  // box -> image coordinates
-  width_ = w;
+  if (box.empty()) return;
+  const int w = box.u1 - box.u0 + 1, h = box.v1 - box.v0 + 1;
+  const int du = box.u0, dv = box.v0;  // box -> image coordinates
   int prev_begin = 0, prev_end = 0;
   // The box's rows are asked of memory a few rows ahead of the scan: a frame just captured is
   // seldom in the cache, and a window's short rows give the hardware's prefetcher little to go on.
@@ -110,7 +106,6 @@ void BlobLabeller::label(const ImageView& g, std::uint8_t t, const PixelBox& req
     prev_begin = cur_begin;
     prev_end = cur_end;
   }
-  binary_filled_ = false;
   // Blobs, and their runs grouped together (counting sort by blob).
   blobs_.clear();
   blob_of_root_.assign(runs_.size(), -1);
@@ -144,25 +139,46 @@ void BlobLabeller::label(const ImageView& g, std::uint8_t t, const PixelBox& req
   }
 }
 
-void BlobLabeller::fill_binary() const {
-  // The 0/1 map, from the runs: the image is read once, the map written where bright.
-  const int h = box_.v1 - box_.v0 + 1;
-  binary_.assign(static_cast<std::size_t>(width_) * h, 0);
-  for (const Run& r : runs_)
-    std::memset(
-        binary_.data() + static_cast<std::size_t>(r.row - box_.v0) * width_ + (r.u0 - box_.u0), 1,
-        static_cast<std::size_t>(r.u1 - r.u0 + 1));
-  binary_filled_ = true;
-}
-
 int BlobLabeller::perimeter(const Blob& b) const {
-  int n = 0;
-  for (int k = 0; k < b.run_count; ++k) {
-    const Run& r = run(b.first_run + k);
-    for (int u = r.u0; u <= r.u1; ++u)
-      if (u == r.u0 || u == r.u1 || !bright(u, r.row - 1) || !bright(u, r.row + 1)) ++n;
+  // A blob's runs come row by row, left to right. A bright 4-neighbour above or below belongs to
+  // the same blob, so a pixel is inside exactly when it is not its run's end and runs of the blob
+  // cover it in the rows above and below. Counted from the runs: no pixel is read.
+  auto at = [&](int k) -> const Run& { return run(b.first_run + k); };
+  auto row_end = [&](int k) {  // the first run past the row of run k
+    const int row = at(k).row;
+    while (k < b.run_count && at(k).row == row) ++k;
+    return k;
+  };
+  // Pixels of [u0, u1] that runs [a, a_end) and runs [c, c_end) both cover.
+  auto covered_twice = [&](int u0, int u1, int a, int a_end, int c, int c_end) {
+    int n = 0;
+    for (; a < a_end && at(a).u0 <= u1; ++a) {
+      const int a0 = std::max(u0, at(a).u0), a1 = std::min(u1, at(a).u1);
+      if (a0 > a1) continue;
+      while (c < c_end && at(c).u1 < a0) ++c;
+      for (int k = c; k < c_end && at(k).u0 <= a1; ++k)
+        n += std::max(0, std::min(a1, at(k).u1) - std::max(a0, at(k).u0) + 1);
+    }
+    return n;
+  };
+  int perimeter = 0;
+  int above = 0, above_end = 0;  // the runs of the row before
+  for (int k = 0; k < b.run_count;) {
+    const int row = at(k).row, end = row_end(k);
+    const bool inner = above_end > above && at(above).row == row - 1 && end < b.run_count &&
+                       at(end).row == row + 1;
+    const int below_end = inner ? row_end(end) : end;
+    for (int r = k; r < end; ++r) {
+      const int length = at(r).u1 - at(r).u0 + 1;
+      perimeter += length;
+      if (inner && length > 2)
+        perimeter -= covered_twice(at(r).u0 + 1, at(r).u1 - 1, above, above_end, end, below_end);
+    }
+    above = k;
+    above_end = end;
+    k = end;
   }
-  return n;
+  return perimeter;
 }
 
 }  // namespace lampnav::vision::detail

@@ -31,31 +31,19 @@ class BlobLabeller {
   // Labels the pixels >= `threshold` of an 8-bit grey image of width x height. The scratch is
   // kept from call to call: no allocation once the sizes have settled.
   void label(const ImageView& grey, std::uint8_t threshold);
-  // The same within `box` only (clipped to the image): runs, blobs and bright() keep the image's
+  // The same within `box` only (clipped to the image): runs and blobs keep the image's
   // coordinates, and pixels outside the box count as dark.
   void label(const ImageView& grey, std::uint8_t threshold, const PixelBox& box);
 
   const std::vector<Blob>& blobs() const { return blobs_; }
-  // The runs of blob b are run(b.first_run) .. run(b.first_run + b.run_count - 1).
+  // The runs of blob b are run(b.first_run) .. run(b.first_run + b.run_count - 1), row by row
+  // and left to right within a row.
   const Run& run(int k) const { return runs_[sorted_[k]]; }
-  // 0/1 per pixel of the last label() call; 0 outside the labelled box. The 0/1 map is written
-  // from the runs on the first call after a labelling (a ceiling frame's detection never asks).
-  // Not for calls from several threads at once, like the rest of the labeller.
-  std::uint8_t bright(int u, int v) const {
-    if (!box_.contains(u, v)) return 0;
-    if (!binary_filled_) fill_binary();
-    return binary_[static_cast<std::size_t>(v - box_.v0) * width_ + (u - box_.u0)];
-  }
-  // Blob pixels with a 4-neighbour that is dark or outside the image.
+  // Blob pixels with a 4-neighbour that is dark or outside the labelled box.
   int perimeter(const Blob& b) const;
 
  private:
   int find_root(int i);
-  void fill_binary() const;
-  PixelBox box_;                              // the labelled pixels
-  int width_ = 0;                             // of box_
-  mutable std::vector<std::uint8_t> binary_;  // bright()'s map, written when first asked for
-  mutable bool binary_filled_ = false;
   std::vector<Run> runs_;
   std::vector<int> sorted_, blob_of_root_, blob_of_run_;
   std::vector<Blob> blobs_;
