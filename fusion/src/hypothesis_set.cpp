@@ -42,8 +42,7 @@ struct HypothesisSet::Impl {
 
   std::vector<Hypothesis> hs;  // best first after every frame
   bool complete = false;
-  int omni_frames = 0;           // omni frames that weighed the set since it became complete
-  int contradicting_images = 0;  // omni images in a row that contradicted every hypothesis
+  int omni_frames = 0;  // omni frames that weighed the set since it became complete
   int next_id = 1;
   std::string last_why = "no omni image yet";
   Counts counts;
@@ -538,7 +537,6 @@ struct HypothesisSet::Impl {
     last_enumeration.reset();
     places.clear();
     hs.clear();
-    contradicting_images = 0;
     complete = false;
     omni_frames = 0;
     last_why = why;
@@ -558,7 +556,6 @@ void HypothesisSet::clear() {
   m.hs.clear();
   m.complete = false;
   m.omni_frames = 0;
-  m.contradicting_images = 0;
   m.twin_cache.clear();
   m.last_enumeration.reset();
   m.places.clear();
@@ -603,11 +600,9 @@ void HypothesisSet::omni(Stamp stamp, const vision::OmniDetection& d,
                     [&](Hypothesis& h) { return m.weigh_omni(h, d); });
     if (m.complete) ++m.omni_frames;
     m.tidy();
-    // Every hypothesis contradicted, image after image: the robot is none of them (carried away
-    // again, or the set lost it). Starting again costs what was learnt, never the pose. One such
-    // image may be one the map cannot explain anywhere (contradicted_images_to_reset).
-    m.contradicting_images = m.complete && all_contradicted ? m.contradicting_images + 1 : 0;
-    if (m.complete && (m.hs.empty() || m.contradicting_images >= m.o.contradicted_images_to_reset))
+    // Every hypothesis contradicted: the robot is none of them (carried away again, or the set
+    // lost it). Starting again costs what was learnt, never the pose.
+    if (m.complete && (m.hs.empty() || all_contradicted))
       m.reset(m.hs.empty() ? "every hypothesis went through a wall"
                            : "the omni view contradicts every hypothesis");
   }

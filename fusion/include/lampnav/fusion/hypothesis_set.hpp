@@ -70,14 +70,6 @@ struct HypothesisSetOptions {
                                  // its best (the truth's own noise stays far inside it)
   double frame_cost_cap = 12.0;  // -2 ln L one omni frame can cost a hypothesis: one odd
                                  // frame (a person under a lamp) never decides alone
-  // Omni images in a row that must contradict every hypothesis (most lamps each predicts in
-  // clear view unseen, or most blobs unexplained) before the set starts again. One such image
-  // can be a view the map cannot explain anywhere: at a corner of a map built from one drive,
-  // most blobs are lamps near the horizon down corridors the drive did not take. Starting again
-  // there dropped the truth, and a search among the map's other places published a pose 8.9 m
-  // off (docs/hypotheses.md, "A map of part of a building"). A robot carried away again is
-  // contradicted image after image, and found one image later.
-  int contradicted_images_to_reset = 2;
   // The same for a ceiling frame: ten a second see the same lamps, so their evidence is far from
   // independent. What repeats (a lamp out, off, or not in the map) is counted once by the
   // ledgers (MapErrorCosts); at 2, the first frame that saw a lamp off lost two thirds of what it
