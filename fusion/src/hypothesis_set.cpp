@@ -141,10 +141,10 @@ struct HypothesisSet::Impl {
     return static_cast<int>(std::count_if(strays.begin(), strays.end(),
                                           [&](const StraySighting& b) { return placed(b); }));
   }
-  // What an image's `unexplained` blobs that place no lamp well enough for a spot cost in full
-  // (the far account's charge before its bound).
-  double far_cost(int unexplained, const std::vector<StraySighting>& strays) const {
-    return omni->options().pairs.spurious_cost * std::max(0, unexplained - placed_strays(strays));
+  // What an image's `unexplained` blobs that place no lamp well enough for a spot (all but
+  // `spots` of them, placed_strays) cost in full: the far account's charge before its bound.
+  double far_cost(int unexplained, int spots) const {
+    return omni->options().pairs.spurious_cost * std::max(0, unexplained - spots);
   }
 
   // Charges what an omni image said of a hypothesis to its ledgers (map_evidence.hpp): the lamps
@@ -166,7 +166,7 @@ struct HypothesisSet::Impl {
                                       stray, o.unmapped_lamp_cost) -
                  stray;
       }
-    const double far = stray * std::max(0, unexplained - spots);  // as far_cost()
+    const double far = far_cost(unexplained, spots);
     delta += detail::charge_account(h.map_costs.far_strays, far, o.far_stray_cost_max) - far;
     for (const auto& [l, c] : lamp_costs)
       delta += detail::charge_misfit(h.map_costs.misfits, l, c, o.lamp_out_cost) - c;
@@ -461,10 +461,11 @@ struct HypothesisSet::Impl {
     // explains at most unmapped_lamp_cost, the far ones at most far_stray_cost_max together.
     const auto capped = [&](const PoseHypothesis& h) {
       const auto& q = omni->options().pairs;
-      const double far = far_cost(h.unexplained, h.strays);
+      const int spots = placed_strays(h.strays);  // placed() asks the map: once a stray
+      const double far = far_cost(h.unexplained, spots);
       return detail::with_each_bounded(
-                 detail::with_each_bounded(h.score, h.missing, q.miss_cost, o.lamp_out_cost),
-                 placed_strays(h.strays), q.spurious_cost, o.unmapped_lamp_cost) -
+                 detail::with_each_bounded(h.score, h.missing, q.miss_cost, o.lamp_out_cost), spots,
+                 q.spurious_cost, o.unmapped_lamp_cost) -
              far + std::min(far, o.far_stray_cost_max);
     };
     double capped_best = capped(r.hypotheses.front());

@@ -163,20 +163,21 @@ int BlobLabeller::perimeter(const Blob& b) const {
   };
   int perimeter = 0;
   int above = 0, above_end = 0;  // the runs of the row before
-  for (int k = 0; k < b.run_count;) {
-    const int row = at(k).row, end = row_end(k);
+  // The row's runs are [k, end), the next row's [end, next_end): each row's end found once.
+  for (int k = 0, end = b.run_count > 0 ? row_end(0) : 0; k < b.run_count;) {
+    const int row = at(k).row, next_end = end < b.run_count ? row_end(end) : end;
     const bool inner = above_end > above && at(above).row == row - 1 && end < b.run_count &&
                        at(end).row == row + 1;
-    const int below_end = inner ? row_end(end) : end;
     for (int r = k; r < end; ++r) {
       const int length = at(r).u1 - at(r).u0 + 1;
       perimeter += length;
       if (inner && length > 2)
-        perimeter -= covered_twice(at(r).u0 + 1, at(r).u1 - 1, above, above_end, end, below_end);
+        perimeter -= covered_twice(at(r).u0 + 1, at(r).u1 - 1, above, above_end, end, next_end);
     }
     above = k;
     above_end = end;
     k = end;
+    end = next_end;
   }
   return perimeter;
 }
