@@ -42,6 +42,9 @@ struct HypothesisSet::Impl {
 
   std::vector<Hypothesis> hs;  // best first after every frame
   bool complete = false;
+  // The image that completed the set was searched alone (no places carried into it) and the map
+  // explains all it shows: its set may publish from it (min_omni_frames does not apply).
+  bool decided_by_one_image = false;
   int omni_frames = 0;  // omni frames that weighed the set since it became complete
   int next_id = 1;
   std::string last_why = "no omni image yet";
@@ -421,6 +424,14 @@ struct HypothesisSet::Impl {
     return missed;
   }
 
+  // Whether a place's blobs no lamp explains include one whose lamp would lie beyond every place
+  // of the map (further than its reach): the image shows what the map lacks.
+  bool beyond_map(const PoseHypothesis& h) const {
+    return std::any_of(h.strays.begin(), h.strays.end(), [&](const StraySighting& b) {
+      return map->node_near(b.at, b.reach) == nullptr;
+    });
+  }
+
   // Births from one image's enumeration. A complete one starts the set again from every place
   // it found, weighed by the image and by what the drive said of the place before it (the kept
   // estimate, if still alive, keeps its prior share and what this image said of it, capped); an
@@ -516,6 +527,7 @@ struct HypothesisSet::Impl {
       places.clear();
       last_enumeration.reset();
       omni_frames = 1;  // this image weighed them
+      decided_by_one_image = !r_with_prior && !beyond_map(r.hypotheses.front());
       last_why.clear();
       return;
     }
@@ -532,6 +544,8 @@ struct HypothesisSet::Impl {
     return odo.travel(last_enumeration->first, stamp) >= o.enumerate_every_m ||
            std::abs(moved.yaw()) >= o.enumerate_every_deg * kDeg;
   }
+
+  int frames_to_publish() const { return decided_by_one_image ? 1 : o.min_omni_frames; }
 
   void reset(const std::string& why) {
     ++counts.resets;
@@ -629,7 +643,7 @@ bool HypothesisSet::complete() const { return impl_->complete; }
 
 const Hypothesis* HypothesisSet::winner() const {
   const Impl& m = *impl_;
-  if (!m.complete || m.hs.empty() || m.omni_frames < m.o.min_omni_frames) return nullptr;
+  if (!m.complete || m.hs.empty() || m.omni_frames < m.frames_to_publish()) return nullptr;
   const Hypothesis& best = m.hs.front();
   if (best.weight < m.o.publish_posterior || best.contradicted) return nullptr;
   if (m.hs.size() > 1 && m.hs[0].log_weight - m.hs[1].log_weight < std::log(m.o.publish_ratio))
@@ -657,7 +671,9 @@ std::string HypothesisSet::why() const {
     case HypothesisVerdict::ambiguous:
       s << m.hs.size() << " places explain what the cameras saw (best " << m.hs.front().weight
         << (m.hs.front().node ? " in " + m.hs.front().node->name : std::string()) << ")";
-      if (m.omni_frames < m.o.min_omni_frames) s << ", waiting for another omni frame";
+      if (m.omni_frames < m.frames_to_publish())
+        s << ", waiting for " << m.frames_to_publish() - m.omni_frames << " more omni frame"
+          << (m.frames_to_publish() - m.omni_frames > 1 ? "s" : "");
       return s.str();
     case HypothesisVerdict::symmetric:
       s << "the building looks the same from " << m.hs.size() << " places (";
