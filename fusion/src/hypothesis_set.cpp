@@ -137,8 +137,11 @@ struct HypothesisSet::Impl {
   // ones: a far stray's reach spans many places, and the search through them cost as much as
   // weighing the hypothesis.)
   bool placed(const StraySighting& b) const {
-    return b.reach <= o.stray_reach_max_m &&
-           (o.count_beyond_map || map->node_near(b.at, b.reach) != nullptr);
+    return b.reach <= o.stray_reach_max_m && (o.count_beyond_map || !beyond_places(b));
+  }
+  // Whether a stray's lamp would lie beyond every place of the map (further than its reach).
+  bool beyond_places(const StraySighting& b) const {
+    return map->node_near(b.at, b.reach) == nullptr;
   }
   int placed_strays(const std::vector<StraySighting>& strays) const {
     return static_cast<int>(std::count_if(strays.begin(), strays.end(),
@@ -424,12 +427,11 @@ struct HypothesisSet::Impl {
     return missed;
   }
 
-  // Whether a place's blobs no lamp explains include one whose lamp would lie beyond every place
-  // of the map (further than its reach): the image shows what the map lacks.
+  // Whether a place's blobs no lamp explains include one beyond every place of the map: the
+  // image shows what the map lacks.
   bool beyond_map(const PoseHypothesis& h) const {
-    return std::any_of(h.strays.begin(), h.strays.end(), [&](const StraySighting& b) {
-      return map->node_near(b.at, b.reach) == nullptr;
-    });
+    return std::any_of(h.strays.begin(), h.strays.end(),
+                       [&](const StraySighting& b) { return beyond_places(b); });
   }
 
   // Births from one image's enumeration. A complete one starts the set again from every place
@@ -671,9 +673,8 @@ std::string HypothesisSet::why() const {
     case HypothesisVerdict::ambiguous:
       s << m.hs.size() << " places explain what the cameras saw (best " << m.hs.front().weight
         << (m.hs.front().node ? " in " + m.hs.front().node->name : std::string()) << ")";
-      if (m.omni_frames < m.frames_to_publish())
-        s << ", waiting for " << m.frames_to_publish() - m.omni_frames << " more omni frame"
-          << (m.frames_to_publish() - m.omni_frames > 1 ? "s" : "");
+      if (const int more = m.frames_to_publish() - m.omni_frames; more > 0)
+        s << ", waiting for " << more << " more omni frame" << (more > 1 ? "s" : "");
       return s.str();
     case HypothesisVerdict::symmetric:
       s << "the building looks the same from " << m.hs.size() << " places (";

@@ -17,7 +17,7 @@ namespace {
 // within the places an image with two seeds allowed, and the true one was not among them.
 // Published at once (min_omni_frames 1), it was the estimate for 30 s and 4 wrong fixes in all;
 // the next image contradicts it, and the set starts again and finds the truth
-// (docs/hypotheses.md, "A map of part of a building").
+// (docs/hypotheses.md, "Three images before a set publishes").
 TEST(PartialMapReplay, ADriveWithoutItsStartIsNeverPublishedWrong) {
   const std::string geojson = test::slurp(test::source_path("maps/office_floor.geojson"));
   const graph::TopologicalMap office = graph::parse_map(geojson, "office_floor.geojson").map;
