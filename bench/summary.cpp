@@ -386,6 +386,13 @@ int main(int argc, char** argv) {
     // decoding and waiting for a core.
     add(std::string("  of which decoded omni image to pose out, p99"),
         counter(bench, "omni_work_p99_ms", 1000), "", std::nullopt, std::nullopt, std::nullopt);
+    // Omni images that gave no pose, only hypotheses: the start not found yet, the first of
+    // them searching the whole map. No pose, so not in the rows above.
+    if (std::string(arg).back() == '0')
+      add(std::string("  omni images before the start was found (no pose out), the slowest to "
+                      "hypotheses out"),
+          counter(bench, "omni_searching_max_ms", 1000), "", std::nullopt, std::nullopt,
+          std::nullopt);
     add_count(std::string("node: messages lost (") + format + ", 30 Hz images, 150 Hz odometry)",
               counter(bench, "lost", 1), 0);
   }
