@@ -21,6 +21,7 @@ void TopologyOptions::validate() const {
   check(corridor_width_m > 0.3 && corridor_width_m < 20, "corridor_width_m", "must be 0.3 to 20 m");
   check(simplify_m > 0, "simplify_m", "must be positive");
   check(min_stretch_m > 0, "min_stretch_m", "must be positive");
+  check(turn_m >= 0, "turn_m", "must not be negative");
   check(same_line_m > 0, "same_line_m", "must be positive");
   check(parallel_deg > 0 && parallel_deg < 45, "parallel_deg", "must be 0 to 45 degrees");
   check(gap_m >= 0, "gap_m", "must not be negative");
@@ -80,6 +81,25 @@ void simplify(const std::vector<Vector2d>& p, std::size_t a, std::size_t b, doub
     simplify(p, a, at, tol, keep);
     keep.push_back(at);
     simplify(p, at, b, tol, keep);
+  }
+}
+
+// The simplified drive's vertices, where a turn left a short stretch beside its corner (the robot
+// settling onto the new corridor's line, or cutting the corner: TopologyOptions::turn_m): its two
+// ends are moved to where the stretches before and after it meet, which leaves it no length. Not
+// for stretches between parallel ones (a U-turn, a hall's turn from one lane to the next) nor where
+// the lines meet far off (a shallow bend).
+void cut_corners_met(std::vector<Vector2d>& v, double turn_m, double parallel) {
+  for (std::size_t i = 1; i + 2 < v.size(); ++i) {
+    const Vector2d before = v[i] - v[i - 1], after = v[i + 2] - v[i + 1];
+    const double cut = (v[i + 1] - v[i]).norm();
+    if (cut >= turn_m || before.norm() < turn_m || after.norm() < turn_m) continue;
+    const double cross = before.x() * after.y() - before.y() * after.x();
+    if (std::abs(cross) <= parallel * before.norm() * after.norm()) continue;
+    const Vector2d d = v[i + 1] - v[i - 1];
+    const Vector2d meet = v[i - 1] + before * ((d.x() * after.y() - d.y() * after.x()) / cross);
+    if ((meet - v[i]).norm() > turn_m || (meet - v[i + 1]).norm() > turn_m) continue;
+    v[i] = v[i + 1] = meet;
   }
 }
 
@@ -186,10 +206,13 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
   simplify(pts, 0, pts.size() - 1, o.simplify_m, keep);
   keep.push_back(pts.size() - 1);
   std::sort(keep.begin(), keep.end());
-  std::vector<Line> lines;
   const double parallel = std::sin(o.parallel_deg * M_PI / 180);
-  for (std::size_t i = 1; i < keep.size(); ++i) {
-    const Vector2d a = pts[keep[i - 1]], b = pts[keep[i]];
+  std::vector<Vector2d> corners;
+  for (const std::size_t k : keep) corners.push_back(pts[k]);
+  cut_corners_met(corners, o.turn_m, parallel);
+  std::vector<Line> lines;
+  for (std::size_t i = 1; i < corners.size(); ++i) {
+    const Vector2d a = corners[i - 1], b = corners[i];
     if ((b - a).norm() < o.min_stretch_m) continue;
     const Vector2d d = canonical(b - a);
     int found = -1;
