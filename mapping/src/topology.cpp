@@ -84,22 +84,36 @@ void simplify(const std::vector<Vector2d>& p, std::size_t a, std::size_t b, doub
   }
 }
 
-// The simplified drive's vertices, where a turn left a short stretch beside its corner (the robot
-// settling onto the new corridor's line, or cutting the corner: TopologyOptions::turn_m): its two
-// ends are moved to where the stretches before and after it meet, which leaves it no length. Not
+// The simplified drive's vertices, where a turn left short stretches beside its corner (the robot
+// approaching it askew, settling onto the new corridor's line, or cutting the corner:
+// TopologyOptions::turn_m): the vertices between the last long stretch before and the first after
+// are moved to where those two stretches' lines meet, which leaves the short ones no length. Not
 // for stretches between parallel ones (a U-turn, a hall's turn from one lane to the next) nor where
 // the lines meet far off (a shallow bend).
 void cut_corners_met(std::vector<Vector2d>& v, double turn_m, double parallel) {
+  const double kSettleCos = std::cos(20 * M_PI / 180);
+  auto length = [&](std::size_t k) { return (v[k + 1] - v[k]).norm(); };  // stretch k
   for (std::size_t i = 1; i + 2 < v.size(); ++i) {
-    const Vector2d before = v[i] - v[i - 1], after = v[i + 2] - v[i + 1];
-    const double cut = (v[i + 1] - v[i]).norm();
-    if (cut >= turn_m || before.norm() < turn_m || after.norm() < turn_m) continue;
+    if (length(i - 1) < turn_m) continue;  // stretch i - 1 is the long one before
+    std::size_t j = i;                     // vertices i..j lie between the two long stretches
+    // Each short stretch runs nearly along the line before or the line after (within 20
+    // degrees): a stretch across the corner at a wider angle is a way of its own (through a
+    // door, a diagonal hall), kept.
+    auto along = [&](std::size_t k, const Vector2d& line) {
+      return std::abs((v[k + 1] - v[k]).normalized().dot(line.normalized())) > kSettleCos;
+    };
+    while (j + 1 < v.size() && length(j) < turn_m &&
+           (along(j, v[i] - v[i - 1]) || (j + 2 < v.size() && along(j, v[j + 2] - v[j + 1]))))
+      ++j;
+    if (j == i || j + 1 >= v.size() || length(j) < turn_m) continue;
+    const Vector2d before = v[i] - v[i - 1], after = v[j + 1] - v[j];
     const double cross = before.x() * after.y() - before.y() * after.x();
     if (std::abs(cross) <= parallel * before.norm() * after.norm()) continue;
-    const Vector2d d = v[i + 1] - v[i - 1];
+    const Vector2d d = v[j] - v[i - 1];
     const Vector2d meet = v[i - 1] + before * ((d.x() * after.y() - d.y() * after.x()) / cross);
-    if ((meet - v[i]).norm() > turn_m || (meet - v[i + 1]).norm() > turn_m) continue;
-    v[i] = v[i + 1] = meet;
+    if ((meet - v[i]).norm() > turn_m || (meet - v[j]).norm() > turn_m) continue;
+    for (std::size_t k = i; k <= j; ++k) v[k] = meet;
+    i = j;
   }
 }
 

@@ -127,13 +127,13 @@ TEST(Topology, OfficeDrivenDownEveryCorridorHasTheTrueTopology) {
             << built.lamp_count() << " lamps\n";
 }
 
-// A loop around six blocks of a generated building, where after each turn the robot leaves the
-// corner a little askew and settles onto the corridor's line 2 m on (0.3 m to the outside, 8.5
-// degrees off it, as the simulator's path follower does): the simplified drive keeps that short
-// stretch, which is not parallel enough to share the corridor's line, so the corridor's run began
-// 2 m past the corner, further than a place reaches. The corridor after each turn was left out with
-// its lamps (36 of 130 on the simulator's loop) before such stretches were met where the lines
-// before and after them meet (TopologyOptions::turn_m).
+// A loop around six blocks of a generated building, where after each turn (and, at two corners,
+// into it) the robot leaves the corner a little askew and settles onto the corridor's line 2 m on
+// (0.3 m to the outside, 8.5 degrees off it, as the simulator's path follower does): the simplified
+// drive keeps that short stretch, which is not parallel enough to share the corridor's line, so the
+// corridor's run began 2 m past the corner, further than a place reaches. The corridor after each
+// turn was left out with its lamps (36 of 130 on the simulator's loop) before such stretches were
+// met where the lines before and after them meet (TopologyOptions::turn_m).
 TEST(Topology, AHeadingSettlingAfterATurnLeavesNoCorridorOut) {
   const graph::TopologicalMap truth =
       generated(100, 5, [](sim::BuildingOptions& bo) { bo.block_m = 30; });
@@ -148,6 +148,9 @@ TEST(Topology, AHeadingSettlingAfterATurnLeavesNoCorridorOut) {
   for (std::size_t i = 1; i + 1 < corners.size(); ++i) {
     const Vector2d in = (corners[i] - corners[i - 1]).normalized();
     const Vector2d out = (corners[i + 1] - corners[i]).normalized();
+    // Askew after the turn at the first two corners; at the others also into it (two short
+    // stretches in a row, 0.3 m off the line 2 m before the corner).
+    if (i > 2) waypoints.push_back(corners[i] - 2.0 * in + 0.3 * out);
     waypoints.push_back(corners[i]);
     waypoints.push_back(corners[i] + 2.0 * out + 0.3 * in);
   }
