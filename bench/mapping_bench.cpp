@@ -194,15 +194,11 @@ void BM_MapBuildFromLog(benchmark::State& state) {
 // Five buildings (seeds of their layout): 5, timed in make bench's table, and four more for the
 // accuracy, which a single drive tells little about. (Seeds 42 and 57 give the layouts of 23
 // and 11 again.)
-BENCHMARK(BM_MapBuildFromLog)
-    ->Arg(5)
-    ->Arg(11)
-    ->Arg(23)
-    ->Arg(31)
-    ->Arg(64)
-    ->Unit(benchmark::kSecond)
-    ->Iterations(1)
-    ->UseRealTime();
+void five_buildings(benchmark::internal::Benchmark* b) {
+  for (const int seed : {5, 11, 23, 31, 64}) b->Arg(seed);
+  b->Unit(benchmark::kSecond)->Iterations(1)->UseRealTime();
+}
+BENCHMARK(BM_MapBuildFromLog)->Apply(five_buildings);
 
 // The drive docs/mapping.md asks for: ten minutes as one loop, around the 90 x 60 m of the
 // building's first three blocks by two (J0_0, J0_3, J2_3, J2_0 and back to J0_0: 300 m), so that
@@ -225,15 +221,7 @@ void BM_MapBuildFromLoop(benchmark::State& state) {
   loop.goal = corners.back();
   build_and_measure(state, b, loop);
 }
-BENCHMARK(BM_MapBuildFromLoop)
-    ->Arg(5)
-    ->Arg(11)
-    ->Arg(23)
-    ->Arg(31)
-    ->Arg(64)
-    ->Unit(benchmark::kSecond)
-    ->Iterations(1)
-    ->UseRealTime();
+BENCHMARK(BM_MapBuildFromLoop)->Apply(five_buildings);
 
 }  // namespace
 }  // namespace lampnav
