@@ -205,8 +205,8 @@ BENCHMARK(BM_MapBuildFromLog)->Apply(five_buildings);
 // the drive's end closes on its start. The buildings' layouts differ little there, so each drive
 // has its own noise (the seed of the wheels, the bumps and the frames: the building's).
 void BM_MapBuildFromLoop(benchmark::State& state) {
-  const Building b = building(static_cast<std::uint64_t>(state.range(0)));
   const std::uint64_t seed = static_cast<std::uint64_t>(state.range(0));
+  const Building b = building(seed);
   const std::vector<std::string> corners = {junction(0, 0), junction(0, 3), junction(2, 3),
                                             junction(2, 0), junction(0, 0)};
   sim::Scenario loop =

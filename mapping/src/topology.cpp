@@ -84,6 +84,14 @@ void simplify(const std::vector<Vector2d>& p, std::size_t a, std::size_t b, doub
   }
 }
 
+// Where the line through `p` along `u` meets the line through `q` along `w` (`cross`, u x w, not
+// 0; u and w need not be unit vectors).
+Vector2d meet_of_lines(const Vector2d& p, const Vector2d& u, const Vector2d& q, const Vector2d& w,
+                       double cross) {
+  const Vector2d d = q - p;
+  return p + u * ((d.x() * w.y() - d.y() * w.x()) / cross);
+}
+
 // The simplified drive's vertices, where a turn left short stretches beside its corner (the robot
 // approaching it askew, settling onto the new corridor's line, or cutting the corner:
 // TopologyOptions::turn_m): the vertices between the last long stretch before and the first after
@@ -93,15 +101,15 @@ void simplify(const std::vector<Vector2d>& p, std::size_t a, std::size_t b, doub
 void cut_corners_met(std::vector<Vector2d>& v, double turn_m, double parallel) {
   const double kSettleCos = std::cos(20 * M_PI / 180);
   auto length = [&](std::size_t k) { return (v[k + 1] - v[k]).norm(); };  // stretch k
+  // Each short stretch runs nearly along the line before or the line after (within 20 degrees):
+  // a stretch across the corner at a wider angle is a way of its own (through a door, a diagonal
+  // hall), kept.
+  auto along = [&](std::size_t k, const Vector2d& line) {
+    return std::abs((v[k + 1] - v[k]).normalized().dot(line.normalized())) > kSettleCos;
+  };
   for (std::size_t i = 1; i + 2 < v.size(); ++i) {
     if (length(i - 1) < turn_m) continue;  // stretch i - 1 is the long one before
     std::size_t j = i;                     // vertices i..j lie between the two long stretches
-    // Each short stretch runs nearly along the line before or the line after (within 20
-    // degrees): a stretch across the corner at a wider angle is a way of its own (through a
-    // door, a diagonal hall), kept.
-    auto along = [&](std::size_t k, const Vector2d& line) {
-      return std::abs((v[k + 1] - v[k]).normalized().dot(line.normalized())) > kSettleCos;
-    };
     while (j + 1 < v.size() && length(j) < turn_m &&
            (along(j, v[i] - v[i - 1]) || (j + 2 < v.size() && along(j, v[j + 2] - v[j + 1]))))
       ++j;
@@ -109,8 +117,7 @@ void cut_corners_met(std::vector<Vector2d>& v, double turn_m, double parallel) {
     const Vector2d before = v[i] - v[i - 1], after = v[j + 1] - v[j];
     const double cross = before.x() * after.y() - before.y() * after.x();
     if (std::abs(cross) <= parallel * before.norm() * after.norm()) continue;
-    const Vector2d d = v[j] - v[i - 1];
-    const Vector2d meet = v[i - 1] + before * ((d.x() * after.y() - d.y() * after.x()) / cross);
+    const Vector2d meet = meet_of_lines(v[i - 1], before, v[j], after, cross);
     if ((meet - v[i]).norm() > turn_m || (meet - v[j]).norm() > turn_m) continue;
     for (std::size_t k = i; k <= j; ++k) v[k] = meet;
     i = j;
@@ -292,9 +299,8 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
       const Line &A = lines[runs[i].line], &B = lines[runs[j].line];
       const double cross = A.dir.x() * B.dir.y() - A.dir.y() * B.dir.x();
       if (std::abs(cross) <= parallel) continue;
-      const Vector2d d = B.origin - A.origin;
-      const double s = (d.x() * B.dir.y() - d.y() * B.dir.x()) / cross;
-      const Vector2d p = A.at(s);
+      const Vector2d p = meet_of_lines(A.origin, A.dir, B.origin, B.dir, cross);
+      const double s = A.along(p);
       const double t = B.along(p);
       if (s < runs[i].s0 - o.place_m || s > runs[i].s1 + o.place_m) continue;
       if (t < runs[j].s0 - o.place_m || t > runs[j].s1 + o.place_m) continue;

@@ -7,7 +7,6 @@
 
 #include <gtest/gtest.h>
 
-#include <Eigen/Geometry>
 #include <functional>
 #include <iostream>
 #include <set>
