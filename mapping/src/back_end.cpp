@@ -133,6 +133,21 @@ struct AxisFactor {
 
 }  // namespace
 
+int axis_for(MappingProblem& pb, double yaw, double gate) {
+  int best = -1;
+  double best_off = gate;
+  for (std::size_t a = 0; a < pb.axes.size(); ++a) {
+    const double off = std::abs(wrap_angle(4 * (yaw - pb.axes[a])) / 4);
+    if (off <= best_off) {
+      best_off = off;
+      best = static_cast<int>(a);
+    }
+  }
+  if (best >= 0) return best;
+  pb.axes.push_back(yaw);
+  return static_cast<int>(pb.axes.size()) - 1;
+}
+
 SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
                   const LampMapperOptions& o, double focal_px, std::size_t first_free) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -213,22 +228,32 @@ SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
                                      new HeightFactor(o.kind_tie_sigma, 0)),
                                  &tie_loss, &kind_height[k], &kind_height[0]);
   }
-  bool any_rectangle = false;
   if (o.square_lamps) {
+    // An axis is free in a whole solve (within 45 degrees of where it was: mod 90, it must not
+    // wander to the next) and in a window that holds all of its lamps; else the fixed past holds
+    // it.
+    std::vector<bool> used(pb.axes.size(), false), held(pb.axes.size(), false);
     for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
-      if (!pb.rectangle[i] || !in_window[i]) continue;
-      any_rectangle = true;
+      const int a = pb.axis_of[i];
+      if (a < 0) continue;
+      if (!in_window[i]) {
+        held[a] = true;
+        continue;
+      }
+      used[a] = true;
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<SquareFactor, 1, 4, 1>(new SquareFactor(o.square_sigma)),
-          nullptr, pb.lamps[i].data(), &pb.square_yaw);
+          nullptr, pb.lamps[i].data(), &pb.axes[a]);
     }
-  }
-  if (any_rectangle && whole) {
-    // The building's axis is fixed by the first lamps' yaws; keep it from wandering by 90 deg.
-    problem.SetParameterLowerBound(&pb.square_yaw, 0, pb.square_yaw - M_PI / 4);
-    problem.SetParameterUpperBound(&pb.square_yaw, 0, pb.square_yaw + M_PI / 4);
-  } else if (any_rectangle) {
-    problem.SetParameterBlockConstant(&pb.square_yaw);
+    for (std::size_t a = 0; a < pb.axes.size(); ++a) {
+      if (!used[a]) continue;
+      if (held[a]) {
+        problem.SetParameterBlockConstant(&pb.axes[a]);
+      } else {
+        problem.SetParameterLowerBound(&pb.axes[a], 0, pb.axes[a] - M_PI / 4);
+        problem.SetParameterUpperBound(&pb.axes[a], 0, pb.axes[a] + M_PI / 4);
+      }
+    }
   }
   const double sigma_n = o.pixel_sigma_px / focal_px;
   std::vector<bool> has_axis(pb.lamps.size(), false);

@@ -17,11 +17,14 @@ struct MappingProblem {
   std::vector<std::array<double, 2>> wheels;  // cumulative wheel travel (left, right) at each
   double semi_axis = 0.2;                     // m
   double wheel_difference = 0;                // estimated: right wheel 1 + d, left 1 - d
-  double square_yaw = 0;                      // estimated: the building's axis (mod 90 degrees)
-  std::vector<double> travel;                 // m from the start at each keyframe
-  std::vector<std::array<double, 4>> lamps;   // landmarks (x, y, z, yaw): estimated
-  std::vector<bool> rectangle;                // per landmark
-  std::vector<int> kind;                      // per landmark: its kind's shared height
+  // The building's axes (mod 90 degrees), estimated: a wing built at an angle to the rest has
+  // its own (an "Atlanta world"). Each rectangular landmark is square to one of them (`axis_of`).
+  std::vector<double> axes;
+  std::vector<double> travel;                // m from the start at each keyframe
+  std::vector<std::array<double, 4>> lamps;  // landmarks (x, y, z, yaw): estimated
+  std::vector<bool> rectangle;               // per landmark
+  std::vector<int> axis_of;                  // per landmark: its axis, or -1 (a disc)
+  std::vector<int> kind;                     // per landmark: its kind's shared height
   struct Sighting {
     int keyframe = 0, lamp = 0;
     Eigen::Vector2d centre = Eigen::Vector2d::Zero();  // undistorted normalized
@@ -51,8 +54,14 @@ struct SolveReport {
 // keyframe by a prior of `carry_sigma_m` and `carry_sigma_yaw` (LampMapperOptions). With
 // `first_free` > 0 only the keyframes from it on and the lamps they see move (their sightings
 // from earlier keyframes anchor them); the wheels and the building's axis are held. The shared
-// height of each kind of lamp is estimated by every solve.
+// height of each kind of lamp is estimated by every solve. Each rectangular landmark is held
+// square to its axis; an axis moves only in a whole solve, or when all of its lamps are free.
 SolveReport solve(MappingProblem& problem, const fusion::CeilingGeometry& geometry,
                   const LampMapperOptions& options, double focal_px, std::size_t first_free = 0);
+
+// The axis a rectangular lamp first placed at `yaw` is square to: the nearest within `gate` rad
+// (mod 90 degrees), or a new one at its yaw. A corridor off the building's grid gets its own
+// axis instead of being pulled onto the grid.
+int axis_for(MappingProblem& problem, double yaw, double gate);
 
 }  // namespace lampnav::mapping

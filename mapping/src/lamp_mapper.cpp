@@ -49,6 +49,8 @@ void LampMapperOptions::validate() const {
   check(huber_sigmas > 0, "huber_sigmas", "must be positive");
   check(wheel_scale_sigma > 0 && wheel_scale_sigma < 0.5, "wheel_scale_sigma", "must be 0 to 0.5");
   check(square_sigma > 0, "square_sigma", "must be positive");
+  check(square_gate_rad > 0 && square_gate_rad < M_PI / 4, "square_gate_rad",
+        "must be between 0 and pi/4");
   check(shared_height_sigma >= 0, "shared_height_sigma", "must not be negative");
   check(kind_tie_sigma >= 0, "kind_tie_sigma", "must not be negative");
   check(kind_tie_max_m > kind_tie_sigma, "kind_tie_max_m", "must be above kind_tie_sigma");
@@ -87,7 +89,6 @@ struct LampMapper::Impl {
   std::vector<double> new_height;
   std::vector<double> last_seen_travel;  // per landmark
   double next_solve_m;
-  bool square_set = false;
   bool revisited = false;  // a landmark seen again after a loop since the last whole solve
   double last_whole_m = -1e9;
   std::optional<Pose2> carried_to;  // set by carried(): the next keyframe's pose
@@ -208,12 +209,9 @@ struct LampMapper::Impl {
           if (const auto dir = geometry.base_direction(d.centre, d.orientation, z0))
             yaw = wrap_angle(*dir + est.yaw());
         }
-        if (rect && !square_set) {
-          pb.square_yaw = yaw;
-          square_set = true;
-        }
         pb.lamps.push_back({at.x(), at.y(), z0, yaw});
         pb.rectangle.push_back(rect);
+        pb.axis_of.push_back(rect && o.square_lamps ? axis_for(pb, yaw, o.square_gate_rad) : -1);
         pb.kind.push_back(kind);
         sizes.emplace_back();
         widths.emplace_back();

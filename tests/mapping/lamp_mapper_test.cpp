@@ -208,5 +208,32 @@ TEST(LampMapper, CeilingsFrom2Point4To8MetresHighMapAlike) {
   }
 }
 
+// Lamps not square to the building: the office's C3 (K1 to K2) with its lamps hung 40 degrees off
+// the grid, driven once, E1 - J1 - K1 - K2 - J2. Each lamp joins the axis it is first placed
+// square to, or starts one: C3's lamps get an axis of their own. With a gate that lets every lamp
+// join the first axis (the one axis of the building before 2026-12-02), C3's lamps are pulled 40
+// degrees onto the grid, the poses with them, and the map beyond C3 bends (a generated building
+// with corridors at 40 to 65 degrees to each other mapped 6 of 24 lamps so, the rest bent out of
+// every place).
+TEST(LampMapper, LampsAtAnAngleToTheGridKeepTheirAngle) {
+  Office askew = Office();
+  askew.map = test::edited(askew.map, [](graph::Node& n) {
+    if (n.name != "C3") return;
+    for (auto& l : n.lamps) l.yaw += 40 * M_PI / 180;
+  });
+  const std::vector<Vector2d> route = {{1, 10}, {21, 10}, {41, 10}, {41, -8}, {21, -8}};
+  const test::DriveRecord drive = askew.drive(route);
+  const Accuracy a = compare(build(drive, askew.robot), askew.map, drive);
+  LampMapperOptions one_axis;
+  one_axis.square_gate_rad = M_PI / 4 - 1e-6;
+  const Accuracy pulled = compare(build(drive, askew.robot, one_axis), askew.map, drive);
+  std::cout << "axes of their own: matched " << a.matched << ", rms " << a.rms_m * 100
+            << " cm, max " << a.max_m * 100 << " cm; one axis: matched " << pulled.matched
+            << ", phantoms " << pulled.phantoms << ", rms " << pulled.rms_m * 100 << " cm, max "
+            << pulled.max_m * 100 << " cm\n";
+  expect_targets(a);
+  EXPECT_GT(pulled.max_m + 0.1 * pulled.phantoms, 0.10);
+}
+
 }  // namespace
 }  // namespace lampnav::mapping

@@ -48,9 +48,15 @@ struct LampMapperOptions {
   double odometry_yaw_sigma_per_m = 0.01;  // rad per sqrt(m) of travel
   double wheel_scale_sigma = 0.01;         // prior on the wheels' relative scale difference (at 0)
   // Rectangular lamps mounted square to the building (their axes 90 degrees apart): holds the
-  // heading along corridors driven once. Turn off for buildings whose lamps are not.
+  // heading along corridors driven once. A new lamp joins the axis its first yaw (from the
+  // wheels since the last solve) is within `square_gate_rad` of (mod 90 degrees), or starts one
+  // of its own: a wing or corridor built at an angle to the rest keeps its angle, and its lamps
+  // are held square to each other. The gate is wide for the wheels' drift between solves (the
+  // simulated wheels' 0.7 % difference turns the heading 1.2 degrees a metre), so a corridor
+  // less than that far off the grid is taken as square.
   bool square_lamps = true;
-  double square_sigma = 0.01;  // rad, how square
+  double square_sigma = 0.01;    // rad, how square
+  double square_gate_rad = 0.2;  // rad, how far off an axis a lamp may first be placed and join it
   // Lamps of one kind hang at one height, within this (m; Huber beyond it). 0: each its own.
   double shared_height_sigma = 0.01;
   // Lamps of several kinds under one ceiling: each kind's height held to the most common kind's
