@@ -55,6 +55,18 @@ struct SquareFactor {
   double sigma_rad;
 };
 
+// Two lamps of a row: the direction from one to the other square to the row's axis.
+struct RowFactor {
+  explicit RowFactor(double sigma) : sigma_rad(sigma) {}
+  template <class T>
+  bool operator()(const T* a, const T* b, const T* axis, T* r) const {
+    const T e = T(4) * (atan2(b[1] - a[1], b[0] - a[0]) - axis[0]);
+    r[0] = atan2(sin(e), cos(e)) / T(4) / T(sigma_rad);
+    return true;
+  }
+  double sigma_rad;
+};
+
 // Lamps of one kind hang at one height (a flat ceiling), robustly: a lamp the drive saw from
 // one side only, or while turning on the spot, borrows the height of its kind; one truly higher
 // pays a bounded price (Huber) and keeps its own. The same between two kinds' heights (`at` 0):
@@ -161,6 +173,7 @@ SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
   po.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   ceres::Problem problem(po);
   ceres::HuberLoss huber(o.huber_sigmas);
+  ceres::HuberLoss row_loss(1.0);  // a lamp hung off its row's line pays linearly
   auto add_pose = [&](std::size_t k) {
     double* p = pb.poses[k].data();
     if (problem.HasParameterBlock(p)) return;
@@ -244,6 +257,24 @@ SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
       problem.AddResidualBlock(
           new ceres::AutoDiffCostFunction<SquareFactor, 1, 4, 1>(new SquareFactor(o.square_sigma)),
           nullptr, pb.lamps[i].data(), &pb.axes[a]);
+    }
+    for (const auto& row : pb.rows) {
+      const bool a_in = in_window[row.from], b_in = in_window[row.to];
+      if (!a_in && !b_in) {
+        held[row.axis] = true;
+        continue;
+      }
+      // The lamp outside the window is fixed with the past, and holds the axis with it.
+      for (const int i : {row.from, row.to}) {
+        if (in_window[i]) continue;
+        held[row.axis] = true;
+        problem.AddParameterBlock(pb.lamps[i].data(), 4);
+        problem.SetParameterBlockConstant(pb.lamps[i].data());
+      }
+      used[row.axis] = true;
+      problem.AddResidualBlock(
+          new ceres::AutoDiffCostFunction<RowFactor, 1, 4, 4, 1>(new RowFactor(o.row_sigma)),
+          &row_loss, pb.lamps[row.from].data(), pb.lamps[row.to].data(), &pb.axes[row.axis]);
     }
     for (std::size_t a = 0; a < pb.axes.size(); ++a) {
       if (!used[a]) continue;

@@ -24,7 +24,14 @@ struct MappingProblem {
   std::vector<std::array<double, 4>> lamps;  // landmarks (x, y, z, yaw): estimated
   std::vector<bool> rectangle;               // per landmark
   std::vector<int> axis_of;                  // per landmark: its axis, or -1 (a disc)
-  std::vector<int> kind;                     // per landmark: its kind's shared height
+  // Lamps without an axis of their own (round, or square and taken for round) placed one after
+  // the other along a straight stretch of the drive: the row's direction is square to `axis`, as
+  // a rectangular lamp's own axis is. What holds the heading along a corridor of such lamps.
+  struct Row {
+    int from = 0, to = 0, axis = 0;
+  };
+  std::vector<Row> rows;
+  std::vector<int> kind;  // per landmark: its kind's shared height
   struct Sighting {
     int keyframe = 0, lamp = 0;
     Eigen::Vector2d centre = Eigen::Vector2d::Zero();  // undistorted normalized

@@ -51,6 +51,10 @@ void LampMapperOptions::validate() const {
   check(square_sigma > 0, "square_sigma", "must be positive");
   check(square_gate_rad > 0 && square_gate_rad < M_PI / 4, "square_gate_rad",
         "must be between 0 and pi/4");
+  check(row_sigma > 0, "row_sigma", "must be positive");
+  check(row_max_m > 0, "row_max_m", "must be positive");
+  check(row_max_turn_rad >= 0 && row_max_turn_rad < M_PI / 4, "row_max_turn_rad",
+        "must be between 0 and pi/4");
   check(shared_height_sigma >= 0, "shared_height_sigma", "must not be negative");
   check(kind_tie_sigma >= 0, "kind_tie_sigma", "must not be negative");
   check(kind_tie_max_m > kind_tie_sigma, "kind_tie_max_m", "must be above kind_tie_sigma");
@@ -88,6 +92,11 @@ struct LampMapper::Impl {
   // the robot passes under it and be taken for another.
   std::vector<double> new_height;
   std::vector<double> last_seen_travel;  // per landmark
+  struct LastRound {
+    int lamp = -1;
+    double robot_yaw = 0;
+  };
+  std::vector<LastRound> last_round;  // per kind: the last round lamp placed (rows)
   double next_solve_m;
   bool revisited = false;  // a landmark seen again after a loop since the last whole solve
   double last_whole_m = -1e9;
@@ -104,6 +113,7 @@ struct LampMapper::Impl {
         next_solve_m(options.solve_every_m) {
     o.validate();
     pb.semi_axis = robot.semi_axis;
+    last_round.resize(new_height.size());
   }
 
   static CameraDescription ceiling_of(const RobotDescription& robot) {
@@ -212,6 +222,7 @@ struct LampMapper::Impl {
         pb.lamps.push_back({at.x(), at.y(), z0, yaw});
         pb.rectangle.push_back(rect);
         pb.axis_of.push_back(rect && o.square_lamps ? axis_for(pb, yaw, o.square_gate_rad) : -1);
+        if (!rect && o.square_lamps) add_row(best, kind, at, est.yaw());
         pb.kind.push_back(kind);
         sizes.emplace_back();
         widths.emplace_back();
@@ -270,6 +281,25 @@ struct LampMapper::Impl {
       }
     }
     return best;
+  }
+
+  // A round lamp just placed at `at` (landmark `lamp`), with the last one of its kind placed
+  // before it: a row when near enough, the drive went straight between them, and the one lies
+  // ahead of the other along it.
+  void add_row(int lamp, int kind, const Vector2d& at, double robot_yaw) {
+    auto& last = last_round[static_cast<std::size_t>(kind)];
+    if (last.lamp >= 0) {
+      const auto& a = pb.lamps[static_cast<std::size_t>(last.lamp)];
+      const Vector2d d = at - Vector2d(a[0], a[1]);
+      if (d.norm() > 0.5 && d.norm() <= o.row_max_m &&
+          std::abs(wrap_angle(robot_yaw - last.robot_yaw)) <= o.row_max_turn_rad) {
+        // Along the drive, not across it (a hall's lamps beside its lane).
+        const double dir = std::atan2(d.y(), d.x());
+        if (std::abs(wrap_angle(2 * (dir - robot_yaw))) / 2 <= o.square_gate_rad)
+          pb.rows.push_back({last.lamp, lamp, axis_for(pb, dir, o.square_gate_rad)});
+      }
+    }
+    last = {lamp, robot_yaw};
   }
 
   void run_solve(std::size_t first_free = 0, int iterations = 0) {

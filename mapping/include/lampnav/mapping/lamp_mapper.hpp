@@ -57,6 +57,14 @@ struct LampMapperOptions {
   bool square_lamps = true;
   double square_sigma = 0.01;    // rad, how square
   double square_gate_rad = 0.2;  // rad, how far off an axis a lamp may first be placed and join it
+  // Round lamps (and square panels, which the kinds' probe takes for round) have no axis: two of
+  // one kind placed one after the other within `row_max_m`, the drive turning less than
+  // `row_max_turn_rad` between them and the second ahead of the first along it (within
+  // `square_gate_rad`), are a row, whose direction joins an axis as a rectangular lamp's does
+  // (Huber beyond `row_sigma`: a lamp hung a centimetre off its row's line).
+  double row_sigma = 0.005;       // rad
+  double row_max_m = 4.0;         // m between the two lamps
+  double row_max_turn_rad = 0.1;  // rad the drive turned between placing them
   // Lamps of one kind hang at one height, within this (m; Huber beyond it). 0: each its own.
   double shared_height_sigma = 0.01;
   // Lamps of several kinds under one ceiling: each kind's height held to the most common kind's
