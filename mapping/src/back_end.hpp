@@ -24,6 +24,7 @@ struct MappingProblem {
   std::vector<std::array<double, 4>> lamps;  // landmarks (x, y, z, yaw): estimated
   std::vector<bool> rectangle;               // per landmark
   std::vector<int> axis_of;                  // per landmark: its axis, or -1 (a disc)
+  std::vector<int> kind;                     // per landmark: its kind's shared height
   // Lamps without an axis of their own (round, or square and taken for round) placed one after
   // the other along a straight stretch of the drive: the row's direction is square to `axis`, as
   // a rectangular lamp's own axis is. What holds the heading along a corridor of such lamps.
@@ -31,7 +32,6 @@ struct MappingProblem {
     int from = 0, to = 0, axis = 0;
   };
   std::vector<Row> rows;
-  std::vector<int> kind;  // per landmark: its kind's shared height
   struct Sighting {
     int keyframe = 0, lamp = 0;
     Eigen::Vector2d centre = Eigen::Vector2d::Zero();  // undistorted normalized
@@ -60,15 +60,16 @@ struct SolveReport {
 // Solves the problem in place; the first keyframe is held fixed (it is the map frame), a carry's
 // keyframe by a prior of `carry_sigma_m` and `carry_sigma_yaw` (LampMapperOptions). With
 // `first_free` > 0 only the keyframes from it on and the lamps they see move (their sightings
-// from earlier keyframes anchor them); the wheels and the building's axis are held. The shared
-// height of each kind of lamp is estimated by every solve. Each rectangular landmark is held
-// square to its axis; an axis moves only in a whole solve, or when all of its lamps are free.
+// from earlier keyframes anchor them); the wheels are held. The shared
+// height of each kind of lamp is estimated by every solve. Each rectangular landmark, and each
+// row's direction, is held square to its axis; an axis moves only in a whole solve, or in a
+// window that holds all of its lamps.
 SolveReport solve(MappingProblem& problem, const fusion::CeilingGeometry& geometry,
                   const LampMapperOptions& options, double focal_px, std::size_t first_free = 0);
 
-// The axis a rectangular lamp first placed at `yaw` is square to: the nearest within `gate` rad
-// (mod 90 degrees), or a new one at its yaw. A corridor off the building's grid gets its own
-// axis instead of being pulled onto the grid.
+// The axis a rectangular lamp first placed at `yaw` (or a row of round lamps in direction `yaw`)
+// is square to: the nearest within `gate` rad (mod 90 degrees), or a new one at `yaw`. A corridor
+// off the building's grid gets its own axis instead of being pulled onto the grid.
 int axis_for(MappingProblem& problem, double yaw, double gate);
 
 }  // namespace lampnav::mapping

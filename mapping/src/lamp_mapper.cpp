@@ -94,7 +94,7 @@ struct LampMapper::Impl {
   std::vector<double> last_seen_travel;  // per landmark
   struct LastRound {
     int lamp = -1;
-    double robot_yaw = 0;
+    double robot_yaw = 0, travel_m = 0;
   };
   std::vector<LastRound> last_round;  // per kind: the last round lamp placed (rows)
   double next_solve_m;
@@ -167,6 +167,7 @@ struct LampMapper::Impl {
     const bool first = pb.poses.empty();
     if (!first && !carried_to && travel - pb.travel.back() < o.keyframe_m) return;
     const bool carry = carried_to.has_value();
+    if (carry) last_round.assign(last_round.size(), {});  // no row across a carry
     const Pose2 est = carry ? *carried_to : estimate(odo);
     carried_to.reset();
     const int kf = static_cast<int>(pb.poses.size());
@@ -222,7 +223,7 @@ struct LampMapper::Impl {
         pb.lamps.push_back({at.x(), at.y(), z0, yaw});
         pb.rectangle.push_back(rect);
         pb.axis_of.push_back(rect && o.square_lamps ? axis_for(pb, yaw, o.square_gate_rad) : -1);
-        if (!rect && o.square_lamps) add_row(best, kind, at, est.yaw());
+        if (!rect && o.square_lamps) add_row(best, kind, at, est, travel);
         pb.kind.push_back(kind);
         sizes.emplace_back();
         widths.emplace_back();
@@ -284,22 +285,22 @@ struct LampMapper::Impl {
   }
 
   // A round lamp just placed at `at` (landmark `lamp`), with the last one of its kind placed
-  // before it: a row when near enough, the drive went straight between them, and the one lies
-  // ahead of the other along it.
-  void add_row(int lamp, int kind, const Vector2d& at, double robot_yaw) {
+  // before it: a row when the drive placed them one after the other (within `row_max_m` of
+  // travel, no carry between), near each other, turning little between them, and the one lies
+  // ahead of the other along the drive.
+  void add_row(int lamp, int kind, const Vector2d& at, const Pose2& robot, double travel_m) {
     auto& last = last_round[static_cast<std::size_t>(kind)];
-    if (last.lamp >= 0) {
+    if (last.lamp >= 0 && travel_m - last.travel_m <= o.row_max_m) {
       const auto& a = pb.lamps[static_cast<std::size_t>(last.lamp)];
       const Vector2d d = at - Vector2d(a[0], a[1]);
+      const double dir = std::atan2(d.y(), d.x());
+      // Along the drive, not across it (a hall's lamps beside its lane).
       if (d.norm() > 0.5 && d.norm() <= o.row_max_m &&
-          std::abs(wrap_angle(robot_yaw - last.robot_yaw)) <= o.row_max_turn_rad) {
-        // Along the drive, not across it (a hall's lamps beside its lane).
-        const double dir = std::atan2(d.y(), d.x());
-        if (std::abs(wrap_angle(2 * (dir - robot_yaw))) / 2 <= o.square_gate_rad)
-          pb.rows.push_back({last.lamp, lamp, axis_for(pb, dir, o.square_gate_rad)});
-      }
+          std::abs(wrap_angle(robot.yaw() - last.robot_yaw)) <= o.row_max_turn_rad &&
+          std::abs(wrap_angle(2 * (dir - robot.yaw()))) / 2 <= o.square_gate_rad)
+        pb.rows.push_back({last.lamp, lamp, axis_for(pb, dir, o.square_gate_rad)});
     }
-    last = {lamp, robot_yaw};
+    last = {lamp, robot.yaw(), travel_m};
   }
 
   void run_solve(std::size_t first_free = 0, int iterations = 0) {
