@@ -41,6 +41,14 @@ struct OdometryFactor {
   double dl, dr, b, sxy, syaw;
 };
 
+// How far `angle` is from being square to `axis` (modulo 90 degrees), signed, in (-pi/4, pi/4].
+template <class T>
+T off_square(const T& angle, const T& axis) {
+  using std::atan2, std::cos, std::sin;
+  const T e = T(4) * (angle - axis);
+  return atan2(sin(e), cos(e)) / T(4);
+}
+
 // Lamps mounted square to the building: a rectangular lamp's axis is the building's axis, or
 // at right angles to it (modulo 90 degrees). A Manhattan-world prior, as indoor SLAM uses; it
 // holds the heading where the wheels alone would drift along a corridor never driven twice.
@@ -48,8 +56,7 @@ struct SquareFactor {
   explicit SquareFactor(double sigma) : sigma_rad(sigma) {}
   template <class T>
   bool operator()(const T* lamp, const T* axis, T* r) const {
-    const T e = T(4) * (lamp[3] - axis[0]);
-    r[0] = atan2(sin(e), cos(e)) / T(4) / T(sigma_rad);
+    r[0] = off_square(lamp[3], axis[0]) / T(sigma_rad);
     return true;
   }
   double sigma_rad;
@@ -60,8 +67,7 @@ struct RowFactor {
   explicit RowFactor(double sigma) : sigma_rad(sigma) {}
   template <class T>
   bool operator()(const T* a, const T* b, const T* axis, T* r) const {
-    const T e = T(4) * (atan2(b[1] - a[1], b[0] - a[0]) - axis[0]);
-    r[0] = atan2(sin(e), cos(e)) / T(4) / T(sigma_rad);
+    r[0] = off_square(T(atan2(b[1] - a[1], b[0] - a[0])), axis[0]) / T(sigma_rad);
     return true;
   }
   double sigma_rad;
@@ -149,7 +155,7 @@ int axis_for(MappingProblem& pb, double yaw, double gate) {
   int best = -1;
   double best_off = gate;
   for (std::size_t a = 0; a < pb.axes.size(); ++a) {
-    const double off = std::abs(wrap_angle(4 * (yaw - pb.axes[a])) / 4);
+    const double off = std::abs(off_square(yaw, pb.axes[a]));
     if (off <= best_off) {
       best_off = off;
       best = static_cast<int>(a);

@@ -216,7 +216,7 @@ TEST(LampMapper, CeilingsFrom2Point4To8MetresHighMapAlike) {
 // with corridors at 40 to 65 degrees to each other mapped 6 of 24 lamps so, the rest bent out of
 // every place).
 TEST(LampMapper, LampsAtAnAngleToTheGridKeepTheirAngle) {
-  Office askew = Office();
+  Office askew;
   askew.map = test::edited(askew.map, [](graph::Node& n) {
     if (n.name != "C3") return;
     for (auto& l : n.lamps) l.yaw += 40 * M_PI / 180;
@@ -241,7 +241,7 @@ TEST(LampMapper, LampsAtAnAngleToTheGridKeepTheirAngle) {
 // rows (2026-12-02, the simulated `E1 -> E2`): 16 of 27 lamps in no place and 14.5 cm RMS, the
 // corridors bent by the wheels' difference.
 TEST(LampMapper, RowsOfRoundLampsHoldTheHeading) {
-  Office round = Office();
+  Office round;
   round.map = test::edited(round.map, [](graph::Node& n) {
     for (auto& l : n.lamps) {
       if (l.shape != graph::LampShape::rectangle) continue;
