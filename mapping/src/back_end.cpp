@@ -166,6 +166,77 @@ int axis_for(MappingProblem& pb, double yaw, double gate) {
   return static_cast<int>(pb.axes.size()) - 1;
 }
 
+std::vector<AxisMember> strained_members(const MappingProblem& pb, double trigger,
+                                         const std::vector<AxisMember>& tried) {
+  // Every lamp and row with an axis, in the order the drive placed them, with how far off it it
+  // lies (signed).
+  struct Off {
+    AxisMember m;
+    int axis, order;
+    double off;
+  };
+  std::vector<Off> all;
+  for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
+    const int a = pb.axis_of[i];
+    if (a < 0) continue;
+    all.push_back({{false, static_cast<int>(i), pb.lamps[i][3]},
+                   a,
+                   static_cast<int>(i),
+                   off_square(pb.lamps[i][3], pb.axes[static_cast<std::size_t>(a)])});
+  }
+  for (std::size_t r = 0; r < pb.rows.size(); ++r) {
+    const auto& row = pb.rows[r];
+    const auto& f = pb.lamps[static_cast<std::size_t>(row.from)];
+    const auto& t = pb.lamps[static_cast<std::size_t>(row.to)];
+    const double dir = std::atan2(t[1] - f[1], t[0] - f[0]);
+    all.push_back({{true, static_cast<int>(r), dir},
+                   row.axis,
+                   row.to,
+                   off_square(dir, pb.axes[static_cast<std::size_t>(row.axis)])});
+  }
+  std::stable_sort(all.begin(), all.end(),
+                   [](const Off& a, const Off& b) { return a.order < b.order; });
+  auto was_tried = [&](const AxisMember& m) {
+    return std::any_of(tried.begin(), tried.end(),
+                       [&](const AxisMember& t) { return t.row == m.row && t.index == m.index; });
+  };
+  // The one furthest off, not tried yet.
+  std::size_t worst = all.size();
+  double worst_off = trigger;
+  for (std::size_t k = 0; k < all.size(); ++k) {
+    if (std::abs(all[k].off) > worst_off && !was_tried(all[k].m)) {
+      worst_off = std::abs(all[k].off);
+      worst = k;
+    }
+  }
+  if (worst == all.size()) return {};
+  // With the members of its axis placed before and after it that lie off it the same way: a
+  // corridor's lamps, one after the other. Those pulled the other way stay.
+  const Off& w = all[worst];
+  std::vector<AxisMember> group = {w.m};
+  for (const int step : {-1, 1}) {
+    for (auto k = static_cast<std::ptrdiff_t>(worst) + step;
+         k >= 0 && k < static_cast<std::ptrdiff_t>(all.size()); k += step) {
+      const Off& o = all[static_cast<std::size_t>(k)];
+      if (o.axis != w.axis) continue;
+      if (o.off * w.off <= 0 || std::abs(o.off) < trigger / 3) break;
+      group.push_back(o.m);
+    }
+  }
+  return group;
+}
+
+void leave_axis(MappingProblem& pb, const std::vector<AxisMember>& group) {
+  pb.axes.push_back(group.front().yaw);
+  const int axis = static_cast<int>(pb.axes.size()) - 1;
+  for (const AxisMember& m : group) {
+    if (m.row)
+      pb.rows[static_cast<std::size_t>(m.index)].axis = axis;
+    else
+      pb.axis_of[static_cast<std::size_t>(m.index)] = axis;
+  }
+}
+
 SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
                   const LampMapperOptions& o, double focal_px, std::size_t first_free) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -337,6 +408,8 @@ SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
     ++n;
   }
   rep.rms_px = n ? std::sqrt(sum / n) : 0.0;
+  rep.chi2 = 2 * summary.final_cost;
+  rep.converged = summary.termination_type == ceres::CONVERGENCE;
   rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return rep;
 }

@@ -55,6 +55,8 @@ struct MappingProblem {
 struct SolveReport {
   double seconds = 0;
   double rms_px = 0;  // reprojection RMS over the sightings, in pixels
+  double chi2 = 0;    // the sum of the squared (robustified) residuals, in sigmas
+  bool converged = false;
 };
 
 // Solves the problem in place; the first keyframe is held fixed (it is the map frame), a carry's
@@ -71,5 +73,23 @@ SolveReport solve(MappingProblem& problem, const fusion::CeilingGeometry& geomet
 // is square to: the nearest within `gate` rad (mod 90 degrees), or a new one at `yaw`. A corridor
 // off the building's grid gets its own axis instead of being pulled onto the grid.
 int axis_for(MappingProblem& problem, double yaw, double gate);
+
+// A lamp or a row that has an axis (the problem's `rows[index]` or `lamps[index]`), and its
+// direction as solved (a lamp's yaw, a row's from one lamp to the other).
+struct AxisMember {
+  bool row = false;
+  int index = 0;
+  double yaw = 0;
+};
+
+// The lamp or row a solve left furthest off its axis (mod 90 degrees), when more than `trigger`
+// rad and not among `tried`, with the members of its axis placed before and after it that lie off
+// it the same way (at least a third of `trigger`): a corridor a few degrees off the grid whose
+// first lamp the wheels placed within the gate of the grid's axis. Empty when none is.
+std::vector<AxisMember> strained_members(const MappingProblem& problem, double trigger,
+                                         const std::vector<AxisMember>& tried);
+
+// Puts `group` on an axis of its own, at its first member's direction.
+void leave_axis(MappingProblem& problem, const std::vector<AxisMember>& group);
 
 }  // namespace lampnav::mapping

@@ -51,6 +51,9 @@ void LampMapperOptions::validate() const {
   check(square_sigma > 0, "square_sigma", "must be positive");
   check(square_gate_rad > 0 && square_gate_rad < M_PI / 4, "square_gate_rad",
         "must be between 0 and pi/4");
+  check(square_release_rad > 0 && square_release_rad <= M_PI / 4, "square_release_rad",
+        "must be above 0 and at most pi/4 (never)");
+  check(square_release_chi2 > 0, "square_release_chi2", "must be positive");
   check(row_sigma > 0, "row_sigma", "must be positive");
   check(row_max_m > 0, "row_max_m", "must be positive");
   check(row_max_turn_rad >= 0 && row_max_turn_rad < M_PI / 4, "row_max_turn_rad",
@@ -74,6 +77,9 @@ constexpr double kRevisitM = 20.0;
 // Lamps are followed from the last keyframe only when it is at most this many keyframe steps
 // back (frames lost in between): further, a wrong height would move the prediction too far.
 constexpr double kFollowSteps = 3.0;
+// At most this many groups of lamps or rows are tried off their axis after one solve (each
+// costs a solve).
+constexpr int kMaxReleases = 12;
 
 struct LampMapper::Impl {
   LampMapperOptions o;
@@ -307,9 +313,29 @@ struct LampMapper::Impl {
     if (pb.poses.size() < 2) return;
     LampMapperOptions so = o;
     if (iterations > 0) so.max_iterations = iterations;
-    const SolveReport r = solve(pb, geometry, so, focal_px, first_free);
+    SolveReport r = solve(pb, geometry, so, focal_px, first_free);
     ++result.solves;
     result.solve_seconds += r.seconds;
+    // A corridor a little off the grid, whose first lamp the wheels placed within the gate of
+    // the grid's axis: its lamps are pulled square, and the camera's sightings turn the poses
+    // that saw them. Such a group, one after the other, leaves for an axis of its own when the
+    // solve then fits the drive better by more than the new axis can explain by chance.
+    std::vector<AxisMember> tried;
+    for (int k = 0; o.square_lamps && r.converged && k < kMaxReleases; ++k) {
+      const std::vector<AxisMember> group = strained_members(pb, o.square_release_rad, tried);
+      if (group.empty()) break;
+      tried.insert(tried.end(), group.begin(), group.end());
+      const MappingProblem before = pb;
+      leave_axis(pb, group);
+      const SolveReport trial = solve(pb, geometry, so, focal_px, first_free);
+      ++result.solves;
+      result.solve_seconds += trial.seconds;
+      if (r.chi2 - trial.chi2 >= o.square_release_chi2) {
+        r = trial;
+      } else {
+        pb = before;
+      }
+    }
     result.final_rms_px = r.rms_px;
     learn_new_height();
   }

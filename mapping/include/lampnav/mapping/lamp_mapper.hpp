@@ -57,6 +57,14 @@ struct LampMapperOptions {
   bool square_lamps = true;
   double square_sigma = 0.01;    // rad, how square
   double square_gate_rad = 0.2;  // rad, how far off an axis a lamp may first be placed and join it
+  // A corridor a few degrees off the grid, inside the gate, is pulled square by the prior, and
+  // the camera's sightings of its lamps turn the poses that saw them. A lamp or row a solve leaves
+  // more than `square_release_rad` off its axis is tried on an axis of its own, with those placed
+  // before and after it that lie off it the same way, and kept there when the solve's chi-square
+  // falls by at least `square_release_chi2` (the new axis is one parameter; on ten 10-minute
+  // drives of square lamps it fell by 11 at most). pi/4: never.
+  double square_release_rad = 0.015;
+  double square_release_chi2 = 16;
   // Round lamps (and square panels, which the kinds' probe takes for round) have no axis: two of
   // one kind placed one after the other within `row_max_m`, the drive turning less than
   // `row_max_turn_rad` between them and the second ahead of the first along it (within
