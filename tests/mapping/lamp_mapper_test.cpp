@@ -8,6 +8,7 @@
 #include <chrono>
 #include <iostream>
 #include <set>
+#include <string>
 
 #include "battery.hpp"
 #include "drive.hpp"
@@ -101,6 +102,21 @@ void expect_targets(const Accuracy& a) {
   EXPECT_LE(a.rms_m, 0.02);
   EXPECT_LE(a.max_m, 0.05);
   EXPECT_LE(a.max_height_m, 0.03);
+}
+
+// Builds `drive` of `office` with the default options and with `off` (what the test is about
+// turned off), prints both, and expects the first to meet the targets and the second to miss
+// them by far (a lamp 10 cm off, or one placed where no lamp is).
+void expect_needed(const Office& office, const test::DriveRecord& drive,
+                   const LampMapperOptions& off, const std::string& on_name,
+                   const std::string& off_name) {
+  const Accuracy a = compare(build(drive, office.robot), office.map, drive);
+  const Accuracy b = compare(build(drive, office.robot, off), office.map, drive);
+  std::cout << on_name << ": matched " << a.matched << ", rms " << a.rms_m * 100 << " cm, max "
+            << a.max_m * 100 << " cm; " << off_name << ": matched " << b.matched << ", phantoms "
+            << b.phantoms << ", rms " << b.rms_m * 100 << " cm, max " << b.max_m * 100 << " cm\n";
+  expect_targets(a);
+  EXPECT_GT(b.max_m + 0.1 * b.phantoms, 0.10);
 }
 
 std::vector<Vector2d> office_loop(int laps) {
@@ -223,18 +239,10 @@ TEST(LampMapper, LampsAtAnAngleToTheGridKeepTheirAngle) {
     for (auto& l : n.lamps) l.yaw += 40 * M_PI / 180;
   });
   const std::vector<Vector2d> route = {{1, 10}, {21, 10}, {41, 10}, {41, -8}, {21, -8}};
-  const test::DriveRecord drive = askew.drive(route);
-  const Accuracy a = compare(build(drive, askew.robot), askew.map, drive);
   LampMapperOptions one_axis;
   one_axis.square_gate_rad = M_PI / 4 - 1e-6;
   one_axis.square_release_rad = M_PI / 4;
-  const Accuracy pulled = compare(build(drive, askew.robot, one_axis), askew.map, drive);
-  std::cout << "axes of their own: matched " << a.matched << ", rms " << a.rms_m * 100
-            << " cm, max " << a.max_m * 100 << " cm; one axis: matched " << pulled.matched
-            << ", phantoms " << pulled.phantoms << ", rms " << pulled.rms_m * 100 << " cm, max "
-            << pulled.max_m * 100 << " cm\n";
-  expect_targets(a);
-  EXPECT_GT(pulled.max_m + 0.1 * pulled.phantoms, 0.10);
+  expect_needed(askew, askew.drive(route), one_axis, "axes of their own", "one axis");
 }
 
 // A corridor a few degrees off the grid, inside the gate: C3 turned 6 degrees about its north end
@@ -261,17 +269,9 @@ TEST(LampMapper, ACorridorAFewDegreesOffTheGridLeavesItsAxis) {
   });
   const std::vector<Vector2d> route = {
       about.transform_from(Vector2d(41, -8)), north, {21, 10}, {1, 10}};
-  const test::DriveRecord drive = askew.drive(route);
-  const Accuracy a = compare(build(drive, askew.robot), askew.map, drive);
   LampMapperOptions held;
   held.square_release_rad = M_PI / 4;
-  const Accuracy pulled = compare(build(drive, askew.robot, held), askew.map, drive);
-  std::cout << "tried off the axis: matched " << a.matched << ", rms " << a.rms_m * 100
-            << " cm, max " << a.max_m * 100 << " cm; held on it: matched " << pulled.matched
-            << ", phantoms " << pulled.phantoms << ", rms " << pulled.rms_m * 100 << " cm, max "
-            << pulled.max_m * 100 << " cm\n";
-  expect_targets(a);
-  EXPECT_GT(pulled.max_m + 0.1 * pulled.phantoms, 0.10);
+  expect_needed(askew, askew.drive(route), held, "tried off the axis", "held on it");
 }
 
 // Round lamps along the corridors: the office with every rectangular lamp made a 0.5 m disc,
@@ -291,17 +291,9 @@ TEST(LampMapper, RowsOfRoundLampsHoldTheHeading) {
     }
   });
   const std::vector<Vector2d> route = {{1, 10}, {21, 10}, {21, -8}, {1, -8}};
-  const test::DriveRecord drive = round.drive(route);
-  const Accuracy a = compare(build(drive, round.robot), round.map, drive);
   LampMapperOptions no_rows;
   no_rows.row_max_m = 0.5;  // no two lamps are that close: no rows
-  const Accuracy without = compare(build(drive, round.robot, no_rows), round.map, drive);
-  std::cout << "rows: matched " << a.matched << ", rms " << a.rms_m * 100 << " cm, max "
-            << a.max_m * 100 << " cm; without: matched " << without.matched << ", phantoms "
-            << without.phantoms << ", rms " << without.rms_m * 100 << " cm, max "
-            << without.max_m * 100 << " cm\n";
-  expect_targets(a);
-  EXPECT_GT(without.max_m + 0.1 * without.phantoms, 0.10);
+  expect_needed(round, round.drive(route), no_rows, "rows", "without");
 }
 
 }  // namespace
