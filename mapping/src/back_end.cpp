@@ -166,34 +166,37 @@ int axis_for(MappingProblem& pb, double yaw, double gate) {
   return static_cast<int>(pb.axes.size()) - 1;
 }
 
+namespace {
+
+// A member's direction as solved: a lamp's yaw, a row's from one lamp to the other.
+double direction(const MappingProblem& pb, const AxisMember& m) {
+  if (!m.row) return pb.lamps[static_cast<std::size_t>(m.index)][3];
+  const auto& row = pb.rows[static_cast<std::size_t>(m.index)];
+  const auto& f = pb.lamps[static_cast<std::size_t>(row.from)];
+  const auto& t = pb.lamps[static_cast<std::size_t>(row.to)];
+  return std::atan2(t[1] - f[1], t[0] - f[0]);
+}
+
+}  // namespace
+
 std::vector<AxisMember> strained_members(const MappingProblem& pb, double trigger,
                                          const std::vector<AxisMember>& tried) {
-  // Every lamp and row with an axis, in the order the drive placed them, with how far off it it
-  // lies (signed).
+  // Every lamp and row with an axis, in the order the drive placed them (a row where its second
+  // lamp was), with how far off its axis it lies (signed).
   struct Off {
     AxisMember m;
     int axis, order;
     double off;
   };
   std::vector<Off> all;
-  for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
-    const int a = pb.axis_of[i];
-    if (a < 0) continue;
-    all.push_back({{false, static_cast<int>(i), pb.lamps[i][3]},
-                   a,
-                   static_cast<int>(i),
-                   off_square(pb.lamps[i][3], pb.axes[static_cast<std::size_t>(a)])});
-  }
-  for (std::size_t r = 0; r < pb.rows.size(); ++r) {
-    const auto& row = pb.rows[r];
-    const auto& f = pb.lamps[static_cast<std::size_t>(row.from)];
-    const auto& t = pb.lamps[static_cast<std::size_t>(row.to)];
-    const double dir = std::atan2(t[1] - f[1], t[0] - f[0]);
-    all.push_back({{true, static_cast<int>(r), dir},
-                   row.axis,
-                   row.to,
-                   off_square(dir, pb.axes[static_cast<std::size_t>(row.axis)])});
-  }
+  auto add = [&](const AxisMember& m, int axis, int order) {
+    all.push_back(
+        {m, axis, order, off_square(direction(pb, m), pb.axes[static_cast<std::size_t>(axis)])});
+  };
+  for (std::size_t i = 0; i < pb.lamps.size(); ++i)
+    if (pb.axis_of[i] >= 0) add({false, static_cast<int>(i)}, pb.axis_of[i], static_cast<int>(i));
+  for (std::size_t r = 0; r < pb.rows.size(); ++r)
+    add({true, static_cast<int>(r)}, pb.rows[r].axis, pb.rows[r].to);
   std::stable_sort(all.begin(), all.end(),
                    [](const Off& a, const Off& b) { return a.order < b.order; });
   auto was_tried = [&](const AxisMember& m) {
@@ -227,7 +230,7 @@ std::vector<AxisMember> strained_members(const MappingProblem& pb, double trigge
 }
 
 void leave_axis(MappingProblem& pb, const std::vector<AxisMember>& group) {
-  pb.axes.push_back(group.front().yaw);
+  pb.axes.push_back(direction(pb, group.front()));
   const int axis = static_cast<int>(pb.axes.size()) - 1;
   for (const AxisMember& m : group) {
     if (m.row)

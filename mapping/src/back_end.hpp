@@ -74,12 +74,10 @@ SolveReport solve(MappingProblem& problem, const fusion::CeilingGeometry& geomet
 // off the building's grid gets its own axis instead of being pulled onto the grid.
 int axis_for(MappingProblem& problem, double yaw, double gate);
 
-// A lamp or a row that has an axis (the problem's `rows[index]` or `lamps[index]`), and its
-// direction as solved (a lamp's yaw, a row's from one lamp to the other).
+// A lamp or a row that has an axis: the problem's `rows[index]` or `lamps[index]`.
 struct AxisMember {
   bool row = false;
   int index = 0;
-  double yaw = 0;
 };
 
 // The lamp or row a solve left furthest off its axis (mod 90 degrees), when more than `trigger`
@@ -89,7 +87,8 @@ struct AxisMember {
 std::vector<AxisMember> strained_members(const MappingProblem& problem, double trigger,
                                          const std::vector<AxisMember>& tried);
 
-// Puts `group` on an axis of its own, at its first member's direction.
+// Puts `group` on an axis of its own, at its first member's direction as solved (a lamp's yaw,
+// a row's from one lamp to the other).
 void leave_axis(MappingProblem& problem, const std::vector<AxisMember>& group);
 
 }  // namespace lampnav::mapping
