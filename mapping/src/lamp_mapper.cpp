@@ -134,13 +134,18 @@ struct LampMapper::Impl {
     return *c;
   }
 
-  // The pose estimate at a dead-reckoned pose: the dead reckoning, corrected by the last
-  // keyframe's solved pose.
-  Pose2 estimate(const Pose2& odometry) const {
-    if (pb.poses.empty()) return odometry;
+  // The pose estimate at `t`: the last keyframe's estimate moved by the wheels' travel since,
+  // each wheel corrected by the difference the last whole solve estimated (the arc the odometry
+  // factor takes), so that between solves the estimate does not curve with the wheels' drift.
+  Pose2 estimate(Stamp t) const {
     const auto& q = pb.poses.back();
-    const Pose2 solved(q[0], q[1], q[2]);
-    return solved * pb.odometry.back().between(odometry);
+    const Pose2 last(q[0], q[1], q[2]);
+    const auto w = wheels_at(t);
+    const double d = pb.wheel_difference;
+    const double l = (1 - d) * (w[0] - pb.wheels.back()[0]);
+    const double r = (1 + d) * (w[1] - pb.wheels.back()[1]);
+    const double ds = (l + r) / 2, dth = (r - l) / (2 * pb.semi_axis);
+    return last * Pose2(ds * std::cos(dth / 2), ds * std::sin(dth / 2), dth);
   }
 
   // The kind of a lamp seen whole: the nearest learnt kind, or long (0) or round (1).
@@ -174,7 +179,7 @@ struct LampMapper::Impl {
     if (!first && !carried_to && travel - pb.travel.back() < o.keyframe_m) return;
     const bool carry = carried_to.has_value();
     if (carry) last_round.assign(last_round.size(), {});  // no row across a carry
-    const Pose2 est = carry ? *carried_to : estimate(odo);
+    const Pose2 est = carry ? *carried_to : first ? odo : estimate(t);
     carried_to.reset();
     const int kf = static_cast<int>(pb.poses.size());
     if (carry) pb.carries.push_back({pb.poses.size(), {est.x(), est.y(), est.yaw()}});
@@ -253,6 +258,9 @@ struct LampMapper::Impl {
       if (!revisited || travel < last_whole_m + o.whole_every_m) {
         first_free = pb.travel.size();
         while (first_free > 1 && pb.travel[first_free - 1] > travel - o.window_m) --first_free;
+        // The first keyframe is the map frame, fixed in every solve: a window from the second
+        // on is the whole drive, and solved as such (the wheels' difference with it).
+        if (first_free <= 1) first_free = 0;
       }
       run_solve(first_free);
       if (first_free == 0) {

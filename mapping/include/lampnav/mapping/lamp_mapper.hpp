@@ -7,15 +7,16 @@
 // followed from the last keyframe across the image (`track_gate`), whatever its height; else it
 // is placed on the ceiling from the current estimate of the pose and joins the nearest landmark
 // of its kind (`kinds`) within `gate_m`, or starts a new one, at the median solved height of its
-// kind
-// (`height_guess_m` before the first solve). The pose estimate is the dead reckoning corrected by
-// the last solve, so a lamp seen again after a loop is placed with the loop's drift only since
-// then.
+// kind (`height_guess_m` before the first solve). The pose estimate is the last keyframe's, as
+// the last solve left it, moved by the wheels with the difference between them that the last
+// whole solve estimated: a lamp seen again after a loop is placed with the loop's drift only
+// since then, and the estimate does not curve with the wheels between solves.
 // Back end (src/back_end.cpp): odometry factors between keyframes from the wheel noise model,
 // reprojection factors on the lamps' centres in undistorted normalized coordinates (the detector's
 // output), and orientation factors for rectangular lamps; a Huber loss on the camera terms. The
-// problem is solved again every `solve_every_m` of travel (the last `window_m` of the drive; all
-// of it when a loop has closed, at most every `whole_every_m`) and at the end.
+// problem is solved again every `solve_every_m` of travel (the last `window_m` of the drive, and
+// so all of it over the first `window_m`; all of it when a loop has closed, at most every
+// `whole_every_m`) and at the end.
 
 #include <Eigen/Core>
 #include <memory>
