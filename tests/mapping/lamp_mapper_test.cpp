@@ -297,6 +297,32 @@ TEST(LampMapper, RowsOfRoundLampsHoldTheHeading) {
   expect_needed(round, round.drive(route), no_rows, "rows", "without");
 }
 
+// Round lamps further apart: the office's discs with every other corridor lamp taken down (4.5 m
+// apart, as under a higher ceiling or with every other lamp failed), driven as above. Until
+// 2026-12-02 two lamps made a row only within 4 m: no row formed, and the simulated `E1 -> E2`
+// on that floor gave no map at all (no straight stretch left), `E2 -> E1` 12.4 cm RMS.
+TEST(LampMapper, RowsOfRoundLampsFourAndAHalfMetresApartHoldTheHeading) {
+  Office sparse;
+  sparse.map = test::edited(sparse.map, [](graph::Node& n) {
+    if (n.place == graph::Place::corridor) {
+      std::vector<graph::Lamp> kept;
+      for (std::size_t i = 0; i < n.lamps.size(); i += 2) kept.push_back(n.lamps[i]);
+      n.lamps = kept;
+    }
+    for (auto& l : n.lamps) {
+      if (l.shape != graph::LampShape::rectangle) continue;
+      l.shape = graph::LampShape::disc;
+      l.length = l.width = 0.5;
+      l.yaw = 0;
+      l.yaw_given = false;
+    }
+  });
+  const std::vector<Vector2d> route = {{1, 10}, {21, 10}, {21, -8}, {1, -8}};
+  LampMapperOptions near_only;
+  near_only.row_max_m = 4.0;
+  expect_needed(sparse, sparse.drive(route), near_only, "rows up to 8 m", "up to 4 m");
+}
+
 // Round lamps off the grid: 0.5 m discs 2.25 m apart along C1, then along a corridor 40 degrees
 // off it for 16 m, then along one parallel to C1 again (the office's other lamps taken down),
 // six drives. Each corridor's row of discs gets an axis; the last corridor joins C1's only when

@@ -70,9 +70,11 @@ struct LampMapperOptions {
   // one kind placed one after the other within `row_max_m`, the drive turning less than
   // `row_max_turn_rad` between them and the second ahead of the first along it (within
   // `square_gate_rad`), are a row, whose direction joins an axis as a rectangular lamp's does
-  // (Huber beyond `row_sigma`: a lamp hung a centimetre off its row's line).
+  // (Huber beyond `row_sigma`: a lamp hung a centimetre off its row's line). `row_max_m` is wide
+  // enough for lamps 4.5 to 6.75 m apart, or a row with a lamp failed (at 4 m, the office's discs
+  // 4.5 m apart made no row and its corridors bent by 25 cm).
   double row_sigma = 0.005;       // rad
-  double row_max_m = 4.0;         // m between the two lamps
+  double row_max_m = 8.0;         // m between the two lamps
   double row_max_turn_rad = 0.1;  // rad the drive turned between placing them
   // Lamps of one kind hang at one height, within this (m; Huber beyond it). 0: each its own.
   double shared_height_sigma = 0.01;
