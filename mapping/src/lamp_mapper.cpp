@@ -8,6 +8,7 @@
 #include "back_end.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/ceiling_geometry.hpp"
+#include "lampnav/fusion/ekf.hpp"
 #include "lampnav/fusion/odometry_track.hpp"
 #include "lampnav/mapping/lamp_kinds.hpp"
 #include "lampnav/vision/camera_models.hpp"
@@ -134,18 +135,18 @@ struct LampMapper::Impl {
     return *c;
   }
 
-  // The pose estimate at `t`: the last keyframe's estimate moved by the wheels' travel since,
-  // each wheel corrected by the difference the last whole solve estimated (the arc the odometry
-  // factor takes), so that between solves the estimate does not curve with the wheels' drift.
+  // The pose estimate at `t`: the last keyframe's estimate moved by the wheels' travel since
+  // (the filter's mid-point arc, as the odometry factor takes it), each wheel corrected by the
+  // difference the last whole solve estimated, so that between solves the estimate does not
+  // curve with the wheels' drift.
   Pose2 estimate(Stamp t) const {
     const auto& q = pb.poses.back();
-    const Pose2 last(q[0], q[1], q[2]);
     const auto w = wheels_at(t);
     const double d = pb.wheel_difference;
-    const double l = (1 - d) * (w[0] - pb.wheels.back()[0]);
-    const double r = (1 + d) * (w[1] - pb.wheels.back()[1]);
-    const double ds = (l + r) / 2, dth = (r - l) / (2 * pb.semi_axis);
-    return last * Pose2(ds * std::cos(dth / 2), ds * std::sin(dth / 2), dth);
+    const Eigen::Vector3d x = fusion::predict_motion(
+        Eigen::Vector3d(q[0], q[1], q[2]), (1 - d) * (w[0] - pb.wheels.back()[0]),
+        (1 + d) * (w[1] - pb.wheels.back()[1]), pb.semi_axis);
+    return Pose2(x.x(), x.y(), x.z());
   }
 
   // The kind of a lamp seen whole: the nearest learnt kind, or long (0) or round (1).
