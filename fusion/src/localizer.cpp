@@ -262,7 +262,7 @@ struct Localizer::Impl {
           ekf.update(ob.measurement->stamp, ob.measurement->pose, ob.measurement->covariance);
       if (r.applied() || r.status == UpdateResult::Status::pending) {
         ++counts.measurements_applied;
-        if (r.applied())
+        if (r.applied() && ob.measurement->heading_measured)
           calibration.heading(ob.measurement->stamp, ob.measurement->pose.yaw(),
                               ob.measurement->covariance(2, 2));
         if (mode == LocalizerMode::relocalized && r.applied())

@@ -42,6 +42,46 @@ struct Term {
   double axis_var = 0;
 };
 
+std::vector<LampId> lamp_ids(const std::vector<LabelledLamp>& lamps) {
+  std::vector<LampId> ids;
+  for (const auto& l : lamps)
+    if (l.lamp && l.detection.view != vision::LampView::partial) ids.push_back(l.lamp->id);
+  return ids;
+}
+
+// One round lamp: a point seen at `base` in the robot's frame, which puts the robot at
+// p(yaw) = lamp - R(yaw) base for whatever the heading is. Written as a pose measurement at the
+// predicted heading whose covariance is free (kFreeHeadingSigma) along the direction in which
+// (p, yaw) moves together, (dp/dyaw, 1): its information is then that of the two-dof point
+// constraint, linearized at the prediction. That direction is the robot turning about the lamp,
+// which one lamp cannot see (the wheels move the robot in its own frame): the heading comes from
+// the next lamp, which the position held at this one now places.
+std::optional<PoseMeasurement> point_measurement(const Term& t,
+                                                 const std::vector<LabelledLamp>& lamps,
+                                                 const Pose2& predicted, Stamp stamp,
+                                                 const PoseMeasurementOptions& o,
+                                                 double tilt_shift) {
+  constexpr double kFreeHeadingSigma = 10.0;  // rad: information 1e-2, nothing beside a prior's
+  const double c = std::cos(predicted.yaw()), s = std::sin(predicted.yaw());
+  Matrix2d R, dR;
+  R << c, -s, s, c;
+  dR << -s, -c, c, -s;
+  const Matrix2d position_cov =
+      R * t.base_cov * R.transpose() +
+      (o.map_sigma * o.map_sigma + tilt_shift * tilt_shift) * Matrix2d::Identity();
+  Vector3d j;
+  j << -dR * t.base, 1.0;
+  PoseMeasurement m;
+  m.stamp = stamp;
+  const Vector2d p = t.map_xy - R * t.base;
+  m.pose = Pose2(p.x(), p.y(), predicted.yaw());
+  m.covariance = kFreeHeadingSigma * kFreeHeadingSigma * j * j.transpose();
+  m.covariance.topLeftCorner<2, 2>() += position_cov;
+  m.heading_measured = false;
+  m.lamps = lamp_ids(lamps);
+  return m;
+}
+
 }  // namespace
 
 std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry,
@@ -93,8 +133,17 @@ std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry,
     return refuse(PoseRefusal::no_usable_lamp, "no fully visible or completed labelled lamp");
   int axes = 0;
   for (const auto& t : terms) axes += t.has_axis;
-  if (terms.size() == 1 && axes == 0)
-    return refuse(PoseRefusal::round_lamp_no_heading, "one round lamp does not give the heading");
+  auto rot = [](double a) {
+    Matrix2d R;
+    R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+    return R;
+  };
+  const double tilt_shift = height_sum / terms.size() * o.tilt_sigma;
+  if (terms.size() == 1 && axes == 0) {
+    if (!o.round_lamp_position)
+      return refuse(PoseRefusal::round_lamp_no_heading, "one round lamp does not give the heading");
+    return point_measurement(terms.front(), lamps, predicted, stamp, o, tilt_shift);
+  }
 
   // Initial heading: a lamp's axis, on the branch (of two, pi apart) nearest the prediction;
   // without axes, the direction between the first two lamps.
@@ -110,11 +159,6 @@ std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry,
     const Vector2d dm = terms[1].map_xy - terms[0].map_xy, db = terms[1].base - terms[0].base;
     yaw = std::atan2(dm.y(), dm.x()) - std::atan2(db.y(), db.x());
   }
-  auto rot = [](double a) {
-    Matrix2d R;
-    R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
-    return R;
-  };
   Vector2d t0 = Vector2d::Zero();
   for (const auto& t : terms) t0 += t.map_xy - rot(yaw) * t.base;
   Vector3d x(t0.x() / terms.size(), t0.y() / terms.size(), yaw);
@@ -164,13 +208,11 @@ std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry,
   m.pose = Pose2(x.x(), x.y(), wrap_angle(x.z()));
   m.covariance = H.inverse();
   // A tilt moves the view of every lamp alike, by the lamp height times the angle.
-  const double shift = height_sum / terms.size() * o.tilt_sigma;
-  m.covariance.topLeftCorner<2, 2>() += shift * shift * Matrix2d::Identity();
+  m.covariance.topLeftCorner<2, 2>() += tilt_shift * tilt_shift * Matrix2d::Identity();
   m.covariance = 0.5 * (m.covariance + m.covariance.transpose()).eval();
   m.chi2 = chi2;
   m.dof = std::max(dof, 0);
-  for (const auto& l : lamps)
-    if (l.lamp && l.detection.view != vision::LampView::partial) m.lamps.push_back(l.lamp->id);
+  m.lamps = lamp_ids(lamps);
   return m;
 }
 

@@ -2,6 +2,8 @@
 
 #include <random>
 
+#include <Eigen/LU>
+
 #include "lampnav/fusion/ceiling_geometry.hpp"
 #include "lampnav/fusion/ceiling_pipeline.hpp"
 #include "lampnav/fusion/chi_square.hpp"
@@ -141,6 +143,61 @@ TEST(PoseFromLamps, CovarianceMatchesMonteCarloSpread) {
   for (int i = 0; i < 3; ++i) EXPECT_NEAR(spread(i, i), reported(i, i), 0.1 * reported(i, i)) << i;
 }
 
+// One round lamp places the robot for a given heading: the measurement sits at the predicted
+// heading, on the line of poses that see the lamp where it was seen (the robot turned about the
+// lamp), and its information is the lamp's two degrees of freedom: none along that line, the
+// pixel noise's across it.
+TEST(PoseFromLamps, OneRoundLampPlacesTheRobotForTheHeading) {
+  const CeilingGeometry g(ceiling_camera());
+  const vision::PinholeCamera lens(ceiling_camera());
+  graph::Lamp disc = rect("D", 3, 1, 0);
+  disc.shape = graph::LampShape::disc;
+  disc.width = disc.length = 0.5;
+  const Pose2 truth(2.7, 1.3, 0.4);
+  std::mt19937 rng(4);
+  const vision::LampDetection d = see(g, truth, disc, rng, 0, 0);
+  const auto base = g.base_point(d.centre, disc.xyz.z());
+  ASSERT_TRUE(base);
+  for (double off : {0.0, 0.05, -0.3}) {
+    const Pose2 predicted(2.5, 1.6, truth.yaw() + off);
+    const auto m = measure_pose(g, lens, {{&disc, d}}, predicted, Stamp{}, {});
+    ASSERT_TRUE(m);
+    EXPECT_FALSE(m->heading_measured);
+    EXPECT_NEAR(m->pose.yaw(), predicted.yaw(), 1e-12);
+    // The robot at the predicted heading that sees the lamp there: the truth turned about it.
+    EXPECT_LT((m->pose.transform_from(*base) - disc.xyz.head<2>()).norm(), 1e-9) << off;
+    if (off == 0.0) {
+      EXPECT_THAT(m->pose, test::IsNearPose(truth, 1e-9, 1e-9));
+    }
+    // Turning about the lamp costs no information; moving off it does. Both moves take the
+    // robot 10 cm: turning by 10 cm over the lever arm to the lamp, or stepping towards it.
+    const Matrix3d info = m->covariance.inverse();
+    const Vector2d lever = m->pose.translation() - disc.xyz.head<2>();
+    const double turn = 0.1 / lever.norm();
+    const Vector3d about(-lever.y() * turn, lever.x() * turn, turn);
+    const Vector3d towards(-0.1 * lever.x() / lever.norm(), -0.1 * lever.y() / lever.norm(), 0);
+    EXPECT_LT(about.dot(info * about), 1e-2) << off;
+    EXPECT_GT(towards.dot(info * towards), 9) << off;  // 10 cm is more than 3 sigmas
+  }
+  // Many frames of pixel noise at the true heading: the position spreads as reported.
+  PoseMeasurementOptions o;
+  o.tilt_sigma = 0;
+  o.map_sigma = 1e-6;
+  const int n = 3000;
+  Eigen::Matrix2d spread = Eigen::Matrix2d::Zero(), reported = Eigen::Matrix2d::Zero();
+  for (int i = 0; i < n; ++i) {
+    const auto m = measure_pose(
+        g, lens, {{&disc, see(g, truth, disc, rng, o.pixel_sigma, 0, &lens)}}, truth, Stamp{}, o);
+    ASSERT_TRUE(m);
+    const Vector2d e = m->pose.translation() - truth.translation();
+    spread += e * e.transpose() / n;
+    // The position's covariance for the heading given: the information's position block.
+    const Matrix3d info = m->covariance.inverse();
+    reported += info.topLeftCorner<2, 2>().inverse() / n;
+  }
+  for (int i = 0; i < 2; ++i) EXPECT_NEAR(spread(i, i), reported(i, i), 0.1 * reported(i, i)) << i;
+}
+
 TEST(PoseFromLamps, RefusesWhatCannotGiveAPose) {
   const CeilingGeometry g(ceiling_camera());
   graph::Lamp disc = rect("D", 3, 1, 0);
@@ -149,8 +206,11 @@ TEST(PoseFromLamps, RefusesWhatCannotGiveAPose) {
   std::mt19937 rng(1);
   const Pose2 truth(3.1, 1.0, 0.2);
   std::string why;
+  PoseMeasurementOptions no_point;
+  no_point.round_lamp_position = false;
   EXPECT_FALSE(measure_pose(g, vision::PinholeCamera(ceiling_camera()),
-                            {{&disc, see(g, truth, disc, rng, 0, 0)}}, truth, Stamp{}, {}, &why));
+                            {{&disc, see(g, truth, disc, rng, 0, 0)}}, truth, Stamp{}, no_point,
+                            &why));
   EXPECT_EQ(why, "one round lamp does not give the heading");
   // Two lamps labelled the wrong way round disagree.
   const graph::Lamp a = rect("A", 3.0, 1.0, 0.0), b = rect("B", 4.2, 1.9, 1.0);

@@ -77,18 +77,6 @@ std::vector<Eigen::Vector3d> lamp_centres(const mapping::MappingResult& mapped) 
   return out;
 }
 
-graph::TopologicalMap edited(const graph::TopologicalMap& map,
-                             const std::function<void(graph::Node&)>& edit) {
-  graph::TopologicalMap out(map.name());
-  for (const graph::Node& n : map.nodes()) {
-    graph::Node c = n;
-    edit(c);
-    out.add_node(c);
-  }
-  for (const auto& e : map.edges()) out.add_edge(e);
-  return out;
-}
-
 Office::Office()
     : map(graph::read_map(source_path("maps/office_floor.geojson")).map),
       robot(read_robot_description(source_path("maps/robots/pioneer.json"))) {}

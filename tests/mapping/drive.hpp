@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "edited_map.hpp"
 #include "lampnav/core/pose2.hpp"
 #include "lampnav/core/time.hpp"
 #include "lampnav/graph/map.hpp"
@@ -45,11 +46,6 @@ struct DriveRecord {
   Pose2 start;
   double length_m = 0;
 };
-
-// A copy of `map` with each node passed through `edit` (lamps moved, added or taken out), the
-// edges as they were.
-graph::TopologicalMap edited(const graph::TopologicalMap& map,
-                             const std::function<void(graph::Node&)>& edit);
 
 // The centres of the lamps a drive mapped.
 std::vector<Eigen::Vector3d> lamp_centres(const mapping::MappingResult& mapped);

@@ -275,17 +275,6 @@ TEST(LampMapper, ACorridorAFewDegreesOffTheGridLeavesItsAxis) {
   expect_needed(askew, askew.drive(route), held, "tried off the axis", "held on it");
 }
 
-// The node's rectangular lamps made 0.5 m discs, as round downlights hang.
-void make_round(graph::Node& n) {
-  for (auto& l : n.lamps) {
-    if (l.shape != graph::LampShape::rectangle) continue;
-    l.shape = graph::LampShape::disc;
-    l.length = l.width = 0.5;
-    l.yaw = 0;
-    l.yaw_given = false;
-  }
-}
-
 // Round lamps along the corridors: the office with every rectangular lamp made a 0.5 m disc,
 // driven E1 - J1 - J2 - E2 once. A disc has no axis; two placed one after the other along the
 // drive are a row, whose direction holds the heading as a rectangular lamp's axis does. Without
@@ -293,7 +282,7 @@ void make_round(graph::Node& n) {
 // corridors bent by the wheels' difference.
 TEST(LampMapper, RowsOfRoundLampsHoldTheHeading) {
   Office round;
-  round.map = test::edited(round.map, [](graph::Node& n) { make_round(n); });
+  round.map = test::edited(round.map, test::make_round);
   const std::vector<Vector2d> route = {{1, 10}, {21, 10}, {21, -8}, {1, -8}};
   LampMapperOptions no_rows;
   no_rows.row_max_m = 0.5;  // no two lamps are that close: no rows
@@ -306,14 +295,7 @@ TEST(LampMapper, RowsOfRoundLampsHoldTheHeading) {
 // on that floor gave no map at all (no straight stretch left), `E2 -> E1` 12.4 cm RMS.
 TEST(LampMapper, RowsOfRoundLampsFourAndAHalfMetresApartHoldTheHeading) {
   Office sparse;
-  sparse.map = test::edited(sparse.map, [](graph::Node& n) {
-    if (n.place == graph::Place::corridor) {
-      std::vector<graph::Lamp> kept;
-      for (std::size_t i = 0; i < n.lamps.size(); i += 2) kept.push_back(n.lamps[i]);
-      n.lamps = kept;
-    }
-    make_round(n);
-  });
+  sparse.map = test::edited(sparse.map, test::sparse_round);
   const std::vector<Vector2d> route = {{1, 10}, {21, 10}, {21, -8}, {1, -8}};
   LampMapperOptions near_only;
   near_only.row_max_m = 4.0;
@@ -349,7 +331,7 @@ TEST(LampMapper, RoundLampsOffTheGridJoinTheirAxisAgain) {
     } else if (n.name != "E1" && n.name != "C1" && n.name != "J1") {
       n.lamps.clear();
     }
-    make_round(n);
+    test::make_round(n);
   });
   const std::vector<Vector2d> route = {{1, 10}, j1, bend, bend + Vector2d(19, 0)};
   for (std::uint64_t seed = 1; seed <= 6; ++seed) {

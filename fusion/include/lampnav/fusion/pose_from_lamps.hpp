@@ -1,7 +1,8 @@
 #pragma once
 // The robot pose measured from labelled lamps of one ceiling frame (paper 2, section 3): one
 // rectangular lamp gives (x, y, yaw) up to the rectangle's 180-degree symmetry, resolved by the
-// predicted yaw; several lamps give a weighted least-squares pose. The covariance is propagated
+// predicted yaw; one round lamp the position for a given heading; several lamps give a weighted
+// least-squares pose. The covariance is propagated
 // from the pixel noise of each detection through the geometry, plus the floor bumps' tilt, which
 // moves every lamp of a frame alike and so is not averaged away by more lamps.
 
@@ -29,7 +30,10 @@ struct PoseMeasurementOptions {
   double map_sigma = 0.005;    // m, survey error of a lamp's position in the map
   double consistency_probability = 0.9999;  // chi-square gate on the fit's residuals: beyond
                                             // it the lamps disagree (a mislabel), refused
-  void validate() const;                    // throws InputError naming the field
+  // One round lamp alone gives the robot's position for a given heading: measured as such
+  // (heading_measured false), or refused (round_lamp_no_heading).
+  bool round_lamp_position = true;
+  void validate() const;  // throws InputError naming the field
 };
 
 struct LabelledLamp {
@@ -44,6 +48,10 @@ struct PoseMeasurement {
   std::vector<LampId> lamps;
   double chi2 = 0;  // weighted squared residuals of the fit (0 for a single lamp)
   int dof = 0;      // residual degrees of freedom
+  // False for one round lamp: `pose` is the predicted heading's point of the position-heading
+  // line the lamp allows, and `covariance` is free along that line (its information is the
+  // lamp's two degrees of freedom). Learn no heading from it.
+  bool heading_measured = true;
 };
 
 // Why the lamps gave no pose.

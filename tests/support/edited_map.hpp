@@ -1,0 +1,45 @@
+#pragma once
+// Test maps edited from the bundled ones: lamps made round, moved, added or taken out.
+
+#include <functional>
+
+#include "lampnav/graph/map.hpp"
+
+namespace lampnav::test {
+
+// A copy of `map` with each node passed through `edit`, the edges as they were.
+inline graph::TopologicalMap edited(const graph::TopologicalMap& map,
+                                    const std::function<void(graph::Node&)>& edit) {
+  graph::TopologicalMap out(map.name());
+  for (const graph::Node& n : map.nodes()) {
+    graph::Node c = n;
+    edit(c);
+    out.add_node(c);
+  }
+  for (const auto& e : map.edges()) out.add_edge(e);
+  return out;
+}
+
+// The node's rectangular lamps made 0.5 m discs, as round downlights hang.
+inline void make_round(graph::Node& n) {
+  for (auto& l : n.lamps) {
+    if (l.shape != graph::LampShape::rectangle) continue;
+    l.shape = graph::LampShape::disc;
+    l.length = l.width = 0.5;
+    l.yaw = 0;
+    l.yaw_given = false;
+  }
+}
+
+// Every other corridor lamp taken down (the first kept), the rest made round: the office's
+// corridors then have 0.5 m discs 4.5 m apart.
+inline void sparse_round(graph::Node& n) {
+  if (n.place == graph::Place::corridor) {
+    std::vector<graph::Lamp> kept;
+    for (std::size_t i = 0; i < n.lamps.size(); i += 2) kept.push_back(n.lamps[i]);
+    n.lamps = kept;
+  }
+  make_round(n);
+}
+
+}  // namespace lampnav::test
