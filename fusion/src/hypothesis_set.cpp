@@ -449,10 +449,23 @@ struct HypothesisSet::Impl {
     bool r_with_prior = with_prior;  // r was enumerated within the carried places
     GlobalLocalization r =
         omni->enumerate(d, o.max_hypotheses, margin, with_prior ? &prior : nullptr);
+    // The places the drive allowed are stale when this image alone puts the robot somewhere it
+    // explains far better than at any of them (carried away while lost: the wheels did not see
+    // it): start again from this image.
+    if (with_prior && r.found()) {
+      GlobalLocalization alone = omni->enumerate(d, o.max_hypotheses, margin);
+      if (alone.found() &&
+          alone.hypotheses.front().score + o.stale_places_cost < r.hypotheses.front().score) {
+        ++counts.stale_places;
+        places.clear();
+        r = std::move(alone);
+        r_with_prior = false;
+      }
+    }
     std::vector<Place> missed;
     if (o.carry_places && (r.found() || r.seeds >= 2)) {
-      missed = update_places(r, with_prior ? &prior : nullptr, stamp, odo);
-      if (with_prior && places.empty()) {
+      missed = update_places(r, r_with_prior ? &prior : nullptr, stamp, odo);
+      if (r_with_prior && places.empty()) {
         // Every place the drive allowed is gone (this image allowed none of them, and what it
         // cost them dropped the rest): the places were lost, or the robot carried away again.
         // Start again from this image alone.

@@ -35,6 +35,7 @@ void HypothesisSetOptions::validate() const {
   check(max_hypotheses >= 1 && max_hypotheses <= 100000, "max_hypotheses", "must be 1 to 100000");
   check(place_gate_m > 0 && place_gate_deg > 0, "place_gate_m", "must be positive");
   check(place_cost_max >= frame_cost_cap, "place_cost_max", "must be at least frame_cost_cap");
+  check(stale_places_cost > 0, "stale_places_cost", "must be positive");
   check(place_allowance >= 0 && place_allowance < frame_cost_cap, "place_allowance",
         "must be in [0, frame_cost_cap)");
   check(drop_ratio > 0 && drop_ratio < 1e-3, "drop_ratio", "must be in (0, 0.001)");

@@ -63,6 +63,12 @@ struct HypothesisSetOptions {
   // off on rendered views), and well under the lamp spacing that separates look-alike places.
   double place_gate_m = 1.0, place_gate_deg = 12.0;
   double place_cost_max = 30.0;
+  // An image that fits some place better than every place the drive allows, by more than this
+  // (-2 ln of the likelihood ratio; 30 is 3e-7), says the places are stale: the robot was carried
+  // while lost, which the wheels do not see. The set starts again from that image. (A kidnap
+  // while lost, 2026-12-03: the drive's places scored 102 on the image that scored 2.4 at the
+  // truth, and the set, kept to them, published a twin 8 m off.)
+  double stale_places_cost = 30.0;
   // Images taken within this distance (m, of the robot) of the last enumeration (a turn on the
   // spot, the omni camera seeing the same ceiling turned) add no cost to the places: their
   // evidence is the last image's again. Counted anew, four images of one spot in a turn dropped
@@ -238,7 +244,8 @@ class HypothesisSet {
   struct Counts {
     std::uint64_t born = 0, merged = 0, through_walls = 0, dropped = 0, resets = 0,
                   enumerations = 0, complete_enumerations = 0,
-                  place_restarts = 0;  // the places the drive allowed all lost: started again
+                  place_restarts = 0,  // the places the drive allowed all lost: started again
+        stale_places = 0;              // an image alone far likelier elsewhere: started again
   };
   const Counts& counts() const;
   const HypothesisSetOptions& options() const;
