@@ -57,18 +57,18 @@ Metrics score(const ReplayResult& r, const io::MissionLog& log) {
     if (e.mode == fusion::LocalizerMode::relocalized) fixes.push_back(e.stamp);
   m.kidnaps = static_cast<int>(kidnaps.size());
   std::vector<double> latency;
-  std::vector<std::pair<Stamp, std::optional<Stamp>>> unsure;  // kidnap to its fix
+  // From a kidnap to the first fix after it, which may come after the next kidnap (carried again
+  // before it was found): the poses until then are not scored, those after it are. A recovery
+  // is a fix before the next kidnap.
+  std::vector<std::pair<Stamp, std::optional<Stamp>>> unsure;
   for (std::size_t k = 0; k < kidnaps.size(); ++k) {
     const Stamp until = k + 1 < kidnaps.size() ? kidnaps[k + 1] : Stamp::max();
-    auto fix = std::find_if(fixes.begin(), fixes.end(),
-                            [&](Stamp s) { return s >= kidnaps[k] && s < until; });
-    if (fix != fixes.end()) {
+    auto fix = std::find_if(fixes.begin(), fixes.end(), [&](Stamp s) { return s >= kidnaps[k]; });
+    if (fix != fixes.end() && *fix < until) {
       ++m.recoveries;
       latency.push_back(to_seconds(*fix - kidnaps[k]));
-      unsure.push_back({kidnaps[k], *fix});
-    } else {
-      unsure.push_back({kidnaps[k], std::nullopt});
     }
+    unsure.push_back({kidnaps[k], fix != fixes.end() ? std::optional<Stamp>(*fix) : std::nullopt});
   }
   m.relocalization_latency_s = stats_of(latency);
   // Errors: tracking estimates outside [kidnap, its fix).

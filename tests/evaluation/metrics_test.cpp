@@ -20,8 +20,10 @@ Stamp at(double s) { return Stamp(std::chrono::milliseconds(std::lround(s * 1000
 // sideways and drives on from there.
 struct Drive {
   std::optional<double> kidnap_at;
+  std::optional<double> again_at;  // carried another 10 m
   Pose2 truth(double t) const {
-    const double y = kidnap_at && t >= *kidnap_at - 1e-9 ? 10.0 : 0.0;
+    double y = kidnap_at && t >= *kidnap_at - 1e-9 ? 10.0 : 0.0;
+    if (again_at && t >= *again_at - 1e-9) y += 10.0;
     return {t, y, 0.0};
   }
 };
@@ -44,9 +46,8 @@ Scripted make_run(const Drive& drive, double seconds, F published, bool with_tru
                                     Eigen::Matrix3d::Identity(), mode, ""});
     if (with_truth) run.log.truth.push_back({at(t), {at(t), truth}});
   }
-  if (drive.kidnap_at)
-    run.log.events.push_back(
-        {at(*drive.kidnap_at), {at(*drive.kidnap_at), io::EventKind::kidnap, "carried 10 m"}});
+  for (const auto& k : {drive.kidnap_at, drive.again_at})
+    if (k) run.log.events.push_back({at(*k), {at(*k), io::EventKind::kidnap, "carried 10 m"}});
   run.result.outcome.first = at(0);
   run.result.outcome.last = at(seconds);
   return run;
@@ -117,6 +118,33 @@ TEST(Score, AKidnapIsExcusedUntilTheLocalizerNoticesAndScoredFromItsFix) {
   // The tracking poses from the kidnap to its fix are not scored: the rest are exact.
   EXPECT_NEAR(m.position_error_m.max, 0.0, 1e-12);
   EXPECT_EQ(m.position_error_m.n, 50u + 36u);
+}
+
+// Carried again while lost: the first carry has no fix of its own (none before the second), and
+// the poses after the fix that ends both are scored. Until 2026-12-03 the first carry left
+// every later pose unscored.
+TEST(Score, CarriedAgainWhileLostIsScoredFromTheFixThatEndsBoth) {
+  Drive drive;
+  drive.kidnap_at = 5.0;
+  drive.again_at = 8.0;
+  Scripted run = make_run(drive, 15.0, [](double t) -> Published {
+    if (t < 5.0 - 1e-9) return {LocalizerMode::tracking, 0.0};
+    if (t < 5.5 - 1e-9) return {LocalizerMode::tracking, -10.0};
+    if (t < 10.0 - 1e-9) return {LocalizerMode::lost, -10.0};
+    if (t < 10.5 - 1e-9) return {LocalizerMode::relocalized, 0.0};
+    if (t >= 12.0 - 1e-9 && t < 13.0 - 1e-9) return {LocalizerMode::tracking, 0.3};
+    return {LocalizerMode::tracking, 0.0};
+  });
+  event(run, 5.5, LocalizerMode::lost, ModeCause::omni_disagrees);
+  event(run, 10.0, LocalizerMode::relocalized, ModeCause::global_fix);
+  event(run, 10.5, LocalizerMode::tracking, ModeCause::confirmed);
+  const Metrics m = score(run.result, run.log);
+  EXPECT_EQ(m.kidnaps, 2);
+  EXPECT_EQ(m.recoveries, 1);  // the second carry's
+  EXPECT_NEAR(m.relocalization_latency_s.max, 2.0, 1e-9);
+  EXPECT_EQ(m.wrong_fixes, 0);
+  EXPECT_EQ(m.position_error_m.n, 50u + 46u);  // before the first carry, and from 10.5 s
+  EXPECT_NEAR(m.position_error_m.max, 0.3, 1e-9);
 }
 
 TEST(Score, AKidnapTheLocalizerNeverNoticesIsAWrongFixAfterTenSeconds) {
