@@ -56,11 +56,9 @@ std::vector<LampId> lamp_ids(const std::vector<LabelledLamp>& lamps) {
 // constraint, linearized at the prediction. That direction is the robot turning about the lamp,
 // which one lamp cannot see (the wheels move the robot in its own frame): the heading comes from
 // the next lamp, which the position held at this one now places.
-std::optional<PoseMeasurement> point_measurement(const Term& t,
-                                                 const std::vector<LabelledLamp>& lamps,
-                                                 const Pose2& predicted, Stamp stamp,
-                                                 const PoseMeasurementOptions& o,
-                                                 double tilt_shift) {
+PoseMeasurement point_measurement(const Term& t, const std::vector<LabelledLamp>& lamps,
+                                  const Pose2& predicted, Stamp stamp,
+                                  const PoseMeasurementOptions& o, double tilt_shift) {
   constexpr double kFreeHeadingSigma = 10.0;  // rad: information 1e-2, nothing beside a prior's
   const double c = std::cos(predicted.yaw()), s = std::sin(predicted.yaw());
   Matrix2d R, dR;
@@ -133,11 +131,6 @@ std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry,
     return refuse(PoseRefusal::no_usable_lamp, "no fully visible or completed labelled lamp");
   int axes = 0;
   for (const auto& t : terms) axes += t.has_axis;
-  auto rot = [](double a) {
-    Matrix2d R;
-    R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
-    return R;
-  };
   const double tilt_shift = height_sum / terms.size() * o.tilt_sigma;
   if (terms.size() == 1 && axes == 0) {
     if (!o.round_lamp_position)
@@ -159,6 +152,11 @@ std::optional<PoseMeasurement> measure_pose(const CeilingGeometry& geometry,
     const Vector2d dm = terms[1].map_xy - terms[0].map_xy, db = terms[1].base - terms[0].base;
     yaw = std::atan2(dm.y(), dm.x()) - std::atan2(db.y(), db.x());
   }
+  auto rot = [](double a) {
+    Matrix2d R;
+    R << std::cos(a), -std::sin(a), std::sin(a), std::cos(a);
+    return R;
+  };
   Vector2d t0 = Vector2d::Zero();
   for (const auto& t : terms) t0 += t.map_xy - rot(yaw) * t.base;
   Vector3d x(t0.x() / terms.size(), t0.y() / terms.size(), yaw);

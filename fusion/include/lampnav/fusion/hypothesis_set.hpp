@@ -243,9 +243,9 @@ class HypothesisSet {
 
   struct Counts {
     std::uint64_t born = 0, merged = 0, through_walls = 0, dropped = 0, resets = 0,
-                  enumerations = 0, complete_enumerations = 0,
-                  place_restarts = 0,  // the places the drive allowed all lost: started again
-        stale_places = 0;              // an image alone far likelier elsewhere: started again
+                  enumerations = 0, complete_enumerations = 0;
+    std::uint64_t place_restarts = 0;  // the places the drive allowed all lost: started again
+    std::uint64_t stale_places = 0;    // an image alone far likelier elsewhere: started again
   };
   const Counts& counts() const;
   const HypothesisSetOptions& options() const;

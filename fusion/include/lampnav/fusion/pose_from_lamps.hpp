@@ -2,9 +2,9 @@
 // The robot pose measured from labelled lamps of one ceiling frame (paper 2, section 3): one
 // rectangular lamp gives (x, y, yaw) up to the rectangle's 180-degree symmetry, resolved by the
 // predicted yaw; one round lamp the position for a given heading; several lamps give a weighted
-// least-squares pose. The covariance is propagated
-// from the pixel noise of each detection through the geometry, plus the floor bumps' tilt, which
-// moves every lamp of a frame alike and so is not averaged away by more lamps.
+// least-squares pose. The covariance is propagated from the pixel noise of each detection through
+// the geometry, plus the floor bumps' tilt, which moves every lamp of a frame alike and so is not
+// averaged away by more lamps.
 
 #include <Eigen/Core>
 #include <optional>
