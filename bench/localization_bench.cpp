@@ -11,6 +11,7 @@
 //    one core's time);
 //  - unknown starts where the map is not the building: its lamps a few centimetres off, lamps
 //    it lacks, lamps out (target: 0 wrong; docs/hypotheses.md, "What is not done").
+//  - kidnaps and unknown starts on a building of round lamps 4.5 m apart (target: 0 wrong).
 // Each runs once (Iterations(1)); the figures are counters.
 
 #include <benchmark/benchmark.h>
@@ -23,6 +24,7 @@
 #include <string>
 
 #include "battery.hpp"
+#include "edited_map.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/sim/building.hpp"
 
@@ -210,6 +212,38 @@ BENCHMARK(BM_UnknownStartsOnAnImperfectMap)
     ->Args({0, 5, 0})
     ->Args({0, 0, 10})
     ->Args({30, 2, 5})
+    ->Unit(benchmark::kSecond)
+    ->Iterations(1)
+    ->UseRealTime();
+
+// Kidnaps and unknown starts on a building of round lamps far apart: the generated building with
+// its corridors' lamps 4.5 m apart (the wing's 5.4 m) and every lamp a 0.5 m disc. The ceiling
+// camera then sees one lamp at a time (docs/localization.md, "One round lamp in the ceiling
+// frame"), the omni camera one to three within 75 degrees of its axis. Target: no wrong fix.
+graph::TopologicalMap round_lamps_far_apart(int nodes) {
+  sim::BuildingOptions o = test::asymmetric_building(nodes);
+  o.lamp_spacing_m = 4.5;
+  o.wing_lamp_spacing_m = 5.4;
+  return test::edited(graph::parse_map(sim::generate_building(o).geojson, "generated").map,
+                      test::make_round);
+}
+
+void BM_RoundLampsFarApartBattery(benchmark::State& state) {
+  const graph::TopologicalMap map = round_lamps_far_apart(static_cast<int>(state.range(0)));
+  const RobotDescription robot =
+      read_robot_description(std::string(LAMPNAV_SOURCE_DIR) + "/maps/robots/pioneer.json");
+  const bool kidnaps = state.range(2) == 1;
+  test::BatteryFigures f;
+  for (auto _ : state)
+    f = run_episodes(map, robot, {}, kidnaps ? 5000 : 7000, static_cast<int>(state.range(1)),
+                     [&](test::Battery& b, std::uint64_t seed) {
+                       return kidnaps ? b.kidnap(seed) : b.unknown_start(seed);
+                     });
+  report(state, f);
+}
+BENCHMARK(BM_RoundLampsFarApartBattery)
+    ->Args({100, 50, 1})  // kidnaps
+    ->Args({100, 20, 0})  // unknown starts
     ->Unit(benchmark::kSecond)
     ->Iterations(1)
     ->UseRealTime();

@@ -411,6 +411,10 @@ int main(int argc, char** argv) {
   for (const auto& [n, count] : {std::pair{"10", "20"}, {"100", "20"}, {"1000", "20"}})
     add_battery(std::string("unknown starts (") + count + "), " + n + "-node building",
                 std::string("BM_UnknownStartBattery/") + n + "/" + count, false);
+  add_battery("kidnaps (50), 100-node building of round lamps 4.5 m apart",
+              "BM_RoundLampsFarApartBattery/100/50/1", true);
+  add_battery("unknown starts (20), the same building", "BM_RoundLampsFarApartBattery/100/20/0",
+              false);
   for (const auto& [args, what] : {std::pair{"30/0/0", "its lamps 3 cm off (sigma)"},
                                    {"50/0/0", "its lamps 5 cm off (sigma)"},
                                    {"0/5/0", "5 % of the lamps not in it"},
