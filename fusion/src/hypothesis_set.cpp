@@ -451,8 +451,9 @@ struct HypothesisSet::Impl {
         omni->enumerate(d, o.max_hypotheses, margin, with_prior ? &prior : nullptr);
     // The places the drive allowed are stale when this image alone puts the robot somewhere it
     // explains far better than at any of them (carried away while lost: the wheels did not see
-    // it): start again from this image.
-    if (with_prior && r.found()) {
+    // it): start again from this image. Scores are never negative, so when the drive's best place
+    // scores within stale_places_cost no place can beat it by that much: no second search.
+    if (with_prior && r.found() && r.hypotheses.front().score > o.stale_places_cost) {
       GlobalLocalization alone = omni->enumerate(d, o.max_hypotheses, margin);
       if (alone.found() &&
           alone.hypotheses.front().score + o.stale_places_cost < r.hypotheses.front().score) {
