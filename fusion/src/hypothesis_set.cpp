@@ -582,7 +582,7 @@ HypothesisSet::HypothesisSet(const graph::TopologicalMap& map,
 HypothesisSet::~HypothesisSet() = default;
 HypothesisSet::HypothesisSet(HypothesisSet&&) noexcept = default;
 
-void HypothesisSet::clear() {
+void HypothesisSet::clear(const std::string& why) {
   Impl& m = *impl_;
   m.hs.clear();
   m.complete = false;
@@ -590,7 +590,7 @@ void HypothesisSet::clear() {
   m.twin_cache.clear();
   m.last_enumeration.reset();
   m.places.clear();
-  m.last_why = "no omni image yet";
+  m.last_why = why;
 }
 
 void HypothesisSet::keep(Stamp stamp, const Pose2& pose, const Eigen::Matrix3d& covariance,

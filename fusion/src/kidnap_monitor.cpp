@@ -189,6 +189,8 @@ const char* to_string(ModeCause cause) {
       return "omni_locates_elsewhere";
     case ModeCause::odometry_gap:
       return "odometry_gap";
+    case ModeCause::moved_unseen:
+      return "moved_unseen";
     case ModeCause::hypotheses_undecided:
       return "hypotheses_undecided";
     case ModeCause::initialized:

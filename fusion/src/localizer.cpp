@@ -31,6 +31,7 @@ void LocalizerOptions::validate() const {
   if (!(max_odometry_gap > Duration::zero()))
     throw InputError({"", "localizer options", "max_odometry_gap"}, "must be positive");
   hypotheses.validate();
+  continuity.validate();
 }
 
 namespace {
@@ -46,6 +47,10 @@ struct Localizer::Impl {
   std::optional<vision::PinholeCamera> ceiling_model;
   std::optional<CeilingGeometry> ceiling_geometry;
   std::optional<vision::LampShapePrior> ceiling_kind;  // the lamps the ceiling camera looks for
+  std::optional<CeilingContinuity> continuity;  // moves the ceiling camera saw and the wheels not
+  // Frames captured before this weigh no hypothesis: the robot was moved after them (a move the
+  // ceiling camera saw), and the dead reckoning cannot carry them across it.
+  std::optional<Stamp> moved_after;
   std::optional<vision::OmniLampDetector> omni_detector;
   std::optional<OmniCheck> omni_check;
   std::optional<GlobalLocalizer> global;
@@ -78,6 +83,8 @@ struct Localizer::Impl {
       ceiling_model.emplace(*ceiling_camera);
       ceiling_geometry.emplace(*ceiling_camera);
       ceiling_kind = shape_prior_for(m, *ceiling_camera);
+      const std::optional<double> z = usual_lamp_height(m);
+      if (o.continuity.enabled && z) continuity.emplace(*ceiling_camera, *z, o.continuity);
     }
     if (const CameraDescription* c = robot.find_camera("omni_camera")) {
       omni_detector.emplace(*c, o.omni_detector);
@@ -85,6 +92,16 @@ struct Localizer::Impl {
       global.emplace(m, *c, o.global);
     }
     hypotheses.emplace(m, ceiling_camera, global ? &*global : nullptr, o.ceiling, o.hypotheses);
+  }
+
+  // The median height of the map's lamps; none for a map without lamps.
+  static std::optional<double> usual_lamp_height(const graph::TopologicalMap& m) {
+    std::vector<double> z;
+    for (const graph::Node& n : m.nodes())
+      for (const graph::Lamp& l : n.lamps) z.push_back(l.xyz.z());
+    if (z.empty()) return std::nullopt;
+    std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+    return z[z.size() / 2];
   }
 
   static LocalizerOptions fix_semi_axis(LocalizerOptions opt, const RobotDescription& robot) {
@@ -154,7 +171,7 @@ struct Localizer::Impl {
 
   // An omni frame while unsure: the hypotheses weighed (and born, while they are not all known).
   void relocalize(Stamp stamp, Localizer& self) {
-    if (before_odometry(stamp)) return;
+    if (before_odometry(stamp) || before_move(stamp)) return;
     ++counts.relocalization_frames;
     hypotheses->omni(stamp, last_omni, odometry);
     settle(stamp, self);
@@ -208,6 +225,27 @@ struct Localizer::Impl {
     return true;
   }
 
+  // A frame captured before a move the ceiling camera saw and the wheels did not.
+  bool before_move(Stamp stamp) {
+    if (!moved_after || stamp >= *moved_after) return false;
+    ++counts.frames_before_move;
+    return true;
+  }
+
+  // The ceiling camera saw a move the wheels did not (a lift): the places the drive allowed, and
+  // every hypothesis carried by the wheels, are stale. While unsure they go, and the robot is
+  // looked for from the frames captured since; while certain it is a kidnap alarm, the estimate
+  // kept as one of the places (a false alarm then costs a few frames, never the pose).
+  void moved_unseen(const ContinuityVerdict& v) {
+    ++counts.unseen_moves;
+    moved_after = v.moved_by;
+    if (unsure()) {
+      hypotheses->clear(v.why);
+      refresh_status();
+      set_mode(LocalizerMode::lost, ModeCause::moved_unseen, v.why);
+    }
+  }
+
   // Odometry stopped and came back (or the clock jumped): where the robot went in between is not
   // known. Nothing from before can be carried across: the hypotheses go, dead reckoning starts
   // again from this reading, and the robot is looked for anew.
@@ -217,6 +255,7 @@ struct Localizer::Impl {
                   "no wheel odometry for %.1f s: the motion in between is not known", gap_s);
     hypotheses->clear();
     odometry = OdometryTrack(o.ekf.semi_axis);
+    if (continuity) continuity->reset();
     ++counts.odometry_gaps;
     if (unsure())
       set_mode(LocalizerMode::lost, ModeCause::odometry_gap, why);
@@ -277,6 +316,14 @@ struct Localizer::Impl {
     }
     lose(monitor.ceiling(e));
   }
+  void check_continuity(const CeilingObservation& ob) {
+    if (!continuity) return;
+    std::vector<vision::LampDetection> lamps;
+    for (const auto& l : ob.lamps) lamps.push_back(l.detection);
+    const ContinuityVerdict v = continuity->frame(ob.stamp, lamps, odometry);
+    if (v.broken) moved_unseen(v);
+  }
+
   // A ceiling frame: an image, or the lamps an outside detector found in one (the pipeline
   // takes either). While unsure, its lamps weigh every hypothesis (labelled from the likeliest
   // place only so that the tracker keeps going).
@@ -305,8 +352,9 @@ struct Localizer::Impl {
       last_ceiling = process(pose, P);
       ++counts.ceiling_frames;
       ++counts.frames_while_lost;
-      if (hs.empty()) return last_ceiling;
-      if (before_odometry(stamp)) return last_ceiling;
+      check_continuity(last_ceiling);
+      if (hypotheses->hypotheses().empty()) return last_ceiling;
+      if (before_odometry(stamp) || before_move(stamp)) return last_ceiling;
       std::vector<vision::LampDetection> lamps;
       for (const auto& l : last_ceiling.lamps) lamps.push_back(l.detection);
       hypotheses->ceiling(stamp, lamps, odometry);
@@ -319,6 +367,7 @@ struct Localizer::Impl {
       return last_ceiling;
     }
     last_ceiling = process(prior->pose(), prior->P);
+    check_continuity(last_ceiling);
     observe(last_ceiling, *prior);
     return last_ceiling;
   }

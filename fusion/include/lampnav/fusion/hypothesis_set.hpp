@@ -216,8 +216,8 @@ class HypothesisSet {
   ~HypothesisSet();
   HypothesisSet(HypothesisSet&&) noexcept;
 
-  // Forgets every hypothesis; the set is empty and incomplete.
-  void clear();
+  // Forgets every hypothesis; the set is empty and incomplete, `why` in words.
+  void clear(const std::string& why = "no omni image yet");
   // After a kidnap alarm: the estimate the robot was tracking stays a hypothesis, at
   // `kept_prior`, until the images decide (a false alarm costs nothing but a few frames).
   void keep(Stamp stamp, const Pose2& pose, const Eigen::Matrix3d& covariance,

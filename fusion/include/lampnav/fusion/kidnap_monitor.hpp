@@ -33,6 +33,7 @@ enum class ModeCause {
   omni_locates_elsewhere,  // one omni check disagrees and the frame locates the robot far away,
                            // far likelier (the second opinion)
   odometry_gap,            // no wheel odometry for too long: the motion in between is unknown
+  moved_unseen,            // the ceiling camera saw a move the wheels did not (a lift)
   hypotheses_undecided,    // lost or ambiguous: the hypotheses do not settle it yet
   initialized,             // a start pose was given
   global_fix,              // relocalized: one hypothesis holds, or a fix from outside

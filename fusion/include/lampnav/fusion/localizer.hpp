@@ -28,6 +28,7 @@
 #include "lampnav/core/localizer_mode.hpp"
 #include "lampnav/core/robot_description.hpp"
 #include "lampnav/core/time.hpp"
+#include "lampnav/fusion/ceiling_continuity.hpp"
 #include "lampnav/fusion/ceiling_pipeline.hpp"
 #include "lampnav/fusion/ekf.hpp"
 #include "lampnav/fusion/global_localizer.hpp"
@@ -55,6 +56,9 @@ struct LocalizerOptions {
   Duration omni_check_period = std::chrono::seconds(1);  // the low-rate omni check
   GlobalLocalizerOptions global;                         // relocalization from omni frames
   HypothesisSetOptions hypotheses;                       // where the robot may be while unsure
+  // Ceiling frames held against the last one through the wheels: a move they did not see (a
+  // lift) makes every place the drive allowed stale (ceiling_continuity.hpp).
+  CeilingContinuityOptions continuity;
   // While tracking, a consistent omni frame refines the estimate's pose on the lamps it matched
   // and is applied as a measurement (at least this many lamps; 0 turns it off).
   int omni_update_min_lamps = 4;
@@ -119,6 +123,8 @@ struct LocalizerCounts {
   std::uint64_t omni_updates = 0;           // omni pose measurements applied while tracking
   std::uint64_t odometry_gaps = 0;          // wheel readings further apart than max_odometry_gap
   std::uint64_t second_opinions = 0;  // losses an omni frame proved by locating the robot elsewhere
+  std::uint64_t unseen_moves = 0;     // ceiling frames that saw a move the wheels did not
+  std::uint64_t frames_before_move = 0;  // captured before such a move: weighed no hypothesis
 };
 
 // Where relocalization stands: the hypotheses and why they do not settle it yet.
