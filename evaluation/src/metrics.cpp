@@ -49,12 +49,21 @@ Metrics score(const ReplayResult& r, const io::MissionLog& log) {
     if (r.estimates[k - 1].mode == fusion::LocalizerMode::ambiguous) m.ambiguous_s += dt;
   }
   // Kidnaps and the fixes after them.
-  std::vector<Stamp> kidnaps, fixes;
+  // A fix or a mode change counts after a kidnap only when it rests on an input captured after
+  // it: one made from a frame captured before the robot was carried, and published after, knew
+  // nothing of the carry (the cameras' frames arrive late), as the tracking poses that follow a
+  // carry until the localizer sees it know nothing of it.
+  std::vector<Stamp> kidnaps;
+  std::vector<const fusion::LocalizerEvent*> fixes;
   for (const auto& e : log.events)
     if (e.value.type() == io::EventKind::kidnap) kidnaps.push_back(e.value.stamp);
   std::sort(kidnaps.begin(), kidnaps.end());
   for (const auto& e : r.events)
-    if (e.mode == fusion::LocalizerMode::relocalized) fixes.push_back(e.stamp);
+    if (e.mode == fusion::LocalizerMode::relocalized) fixes.push_back(&e);
+  // (A frame captured at the instant of the kidnap event shows the robot before the move.)
+  const auto after = [](const fusion::LocalizerEvent& e, Stamp k) {
+    return e.stamp >= k && e.evidence > k;
+  };
   m.kidnaps = static_cast<int>(kidnaps.size());
   std::vector<double> latency;
   // From a kidnap to the first fix after it, which may come after the next kidnap (carried again
@@ -63,12 +72,14 @@ Metrics score(const ReplayResult& r, const io::MissionLog& log) {
   std::vector<std::pair<Stamp, std::optional<Stamp>>> unsure;
   for (std::size_t k = 0; k < kidnaps.size(); ++k) {
     const Stamp until = k + 1 < kidnaps.size() ? kidnaps[k + 1] : Stamp::max();
-    auto fix = std::find_if(fixes.begin(), fixes.end(), [&](Stamp s) { return s >= kidnaps[k]; });
-    if (fix != fixes.end() && *fix < until) {
+    auto fix = std::find_if(fixes.begin(), fixes.end(),
+                            [&](const fusion::LocalizerEvent* e) { return after(*e, kidnaps[k]); });
+    if (fix != fixes.end() && (*fix)->stamp < until) {
       ++m.recoveries;
-      latency.push_back(to_seconds(*fix - kidnaps[k]));
+      latency.push_back(to_seconds((*fix)->stamp - kidnaps[k]));
     }
-    unsure.push_back({kidnaps[k], fix != fixes.end() ? std::optional<Stamp>(*fix) : std::nullopt});
+    unsure.push_back(
+        {kidnaps[k], fix != fixes.end() ? std::optional<Stamp>((*fix)->stamp) : std::nullopt});
   }
   m.relocalization_latency_s = stats_of(latency);
   // Errors: tracking estimates outside [kidnap, its fix).
@@ -90,12 +101,13 @@ Metrics score(const ReplayResult& r, const io::MissionLog& log) {
   m.position_error_m = stats_of(pos);
   m.yaw_error_deg = stats_of(yaw);
   // Wrong fixes: a pose published as certain more than 0.5 m off, except between a kidnap and
-  // the localizer noticing it (the first mode change after it), 10 s at most.
+  // the localizer noticing it (the first mode change after it, on an input captured after it),
+  // 10 s at most.
   std::vector<std::pair<Stamp, Stamp>> unnoticed;
   for (const Stamp k : kidnaps) {
     Stamp until = k + std::chrono::seconds(10);
     for (const auto& e : r.events)
-      if (e.stamp >= k && e.mode != fusion::LocalizerMode::tracking) {
+      if (after(e, k) && e.mode != fusion::LocalizerMode::tracking) {
         until = std::min(until, e.stamp);
         break;
       }

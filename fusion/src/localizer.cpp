@@ -67,6 +67,7 @@ struct Localizer::Impl {
   Stamp last_omni_stamp;
   std::optional<Stamp> last_omni_check;
   std::vector<LocalizerEvent> events;
+  Stamp evidence;  // capture time of the input being taken in (LocalizerEvent::evidence)
   LocalizerCounts counts;
 
   Impl(const graph::TopologicalMap& m, const RobotDescription& robot, LocalizerOptions opt)
@@ -120,7 +121,7 @@ struct Localizer::Impl {
     if (m == mode) return;
     const bool was_unsure = unsure();
     mode = m;
-    events.push_back({now(), m, cause, why});
+    events.push_back({now(), m, cause, why, evidence});
     if (unsure() && !was_unsure) {
       if (pipeline) pipeline->reset();  // its labels are worthless
       calibration.forget_measurements();
@@ -137,6 +138,36 @@ struct Localizer::Impl {
     return out;
   }
 
+  // A fix (from the hypotheses, or from outside): re-initializes the filter at its capture time.
+  bool apply_fix(const GlobalFix& fix) {
+    ++counts.global_fixes;
+    if (!ekf.initialized()) {
+      try {
+        // The odometry read since the fix's capture moves it to the latest reading.
+        Stamp at = fix.stamp;
+        Pose2 pose = fix.pose;
+        if (!odometry.empty() && odometry.last_stamp() > fix.stamp) {
+          at = odometry.last_stamp();
+          pose = fix.pose * odometry.at(fix.stamp).between(odometry.last());
+        }
+        ekf.initialize(at, pose, fix.covariance);
+      } catch (const InputError&) {
+        ++counts.fixes_refused;
+        return false;
+      }
+    } else if (ekf.restart_at(fix.stamp, fix.pose, fix.covariance)) {
+      ++counts.fixes_refused;
+      return false;
+    }
+    monitor.reset();
+    if (pipeline) pipeline->reset();
+    calibration.forget_measurements();
+    hypotheses->clear();
+    set_mode(LocalizerMode::relocalized, ModeCause::global_fix,
+             "global fix" + (fix.source.empty() ? std::string() : " from " + fix.source));
+    return true;
+  }
+
   // After a frame weighed the hypotheses: a fix when one holds the evidence, else the mode says
   // whether the places the robot may be are all known (ambiguous) or not (lost).
   // The relocalization status from the hypothesis set as it stands.
@@ -148,14 +179,14 @@ struct Localizer::Impl {
       relocalization.hypotheses.push_back({h.pose, h.covariance, h.weight, h.node});
   }
 
-  void settle(Stamp stamp, Localizer& self) {
+  void settle(Stamp stamp) {
     refresh_status();
     if (const Hypothesis* w = hypotheses->winner()) {
       // Carried to the newest odometry, so the fix is inside the filter's history.
       const Stamp at = odometry.empty() ? stamp : std::max(stamp, odometry.last_stamp());
       const Hypothesis c = hypotheses->carried(*w, at, odometry);
       relocalization.why.clear();
-      if (self.global_fix({at, c.pose, c.covariance, "omni"})) {
+      if (apply_fix({at, c.pose, c.covariance, "omni"})) {
         hypotheses->clear();
         return;
       }
@@ -170,11 +201,11 @@ struct Localizer::Impl {
   }
 
   // An omni frame while unsure: the hypotheses weighed (and born, while they are not all known).
-  void relocalize(Stamp stamp, Localizer& self) {
+  void relocalize(Stamp stamp) {
     if (before_odometry(stamp) || before_move(stamp)) return;
     ++counts.relocalization_frames;
     hypotheses->omni(stamp, last_omni, odometry);
-    settle(stamp, self);
+    settle(stamp);
   }
 
   // An omni check disagreed with the estimate once: does the frame itself put the robot
@@ -243,6 +274,8 @@ struct Localizer::Impl {
       hypotheses->clear(v.why);
       refresh_status();
       set_mode(LocalizerMode::lost, ModeCause::moved_unseen, v.why);
+    } else {
+      lose(LossVerdict{ModeCause::moved_unseen, v.why});
     }
   }
 
@@ -336,6 +369,7 @@ struct Localizer::Impl {
     };
     last_ceiling = CeilingObservation{};
     last_ceiling.stamp = stamp;
+    evidence = stamp;
     const std::optional<FilterState> prior = self.prior_at(stamp);
     if (unsure()) {
       Pose2 pose;
@@ -358,7 +392,7 @@ struct Localizer::Impl {
       std::vector<vision::LampDetection> lamps;
       for (const auto& l : last_ceiling.lamps) lamps.push_back(l.detection);
       hypotheses->ceiling(stamp, lamps, odometry);
-      settle(stamp, self);
+      settle(stamp);
       return last_ceiling;
     }
     if (!prior) {
@@ -386,13 +420,16 @@ void Localizer::initialize(Stamp stamp, const Pose2& pose, const Eigen::Matrix3d
   if (m.pipeline) m.pipeline->reset();
   m.hypotheses->clear();
   m.mode = LocalizerMode::tracking;
-  m.events.push_back({stamp, LocalizerMode::tracking, ModeCause::initialized, "initialized"});
+  m.evidence = stamp;
+  m.events.push_back(
+      {stamp, LocalizerMode::tracking, ModeCause::initialized, "initialized", stamp});
 }
 
 bool Localizer::initialized() const { return impl_->ekf.initialized(); }
 
 std::optional<Refusal> Localizer::wheels(Stamp stamp, double left, double right) {
   Impl& m = *impl_;
+  m.evidence = stamp;
   ++m.counts.wheel_readings;
   // The first reading is the baseline (no motion); NaN or inf is refused by the filter.
   const auto [left0, right0] = m.last_wheels.value_or(std::pair{left, right});
@@ -431,6 +468,7 @@ const CeilingObservation& Localizer::ceiling_detections(
 }
 
 void Localizer::ceiling_observation(const CeilingObservation& ob) {
+  impl_->evidence = ob.stamp;
   if (impl_->unsure()) {
     ++impl_->counts.frames_while_lost;  // labelled from a pose that is not known
     return;
@@ -456,9 +494,10 @@ void Localizer::omni_detection(Stamp stamp, const vision::OmniDetection& detecti
   if (!m.global) throw InputError({"", "robot.json", "cameras"}, "the robot has no omni_camera");
   m.last_omni = detection;
   m.last_omni_stamp = stamp;
+  m.evidence = stamp;
   ++m.counts.omni_frames;
   if (m.unsure() || !m.ekf.initialized()) {
-    m.relocalize(stamp, *this);
+    m.relocalize(stamp);
     return;
   }
   if (m.last_omni_check && stamp - *m.last_omni_check < m.o.omni_check_period) return;
@@ -476,40 +515,15 @@ void Localizer::omni_detection(Stamp stamp, const vision::OmniDetection& detecti
   }
   m.lose(loss);
   if (m.unsure()) {
-    m.relocalize(stamp, *this);  // the frame that showed the loss shows where the robot is
+    m.relocalize(stamp);  // the frame that showed the loss shows where the robot is
   } else if (r.conclusive && r.consistent && m.o.omni_update_min_lamps > 0) {
     m.omni_update(stamp, *prior);
   }
 }
 
 bool Localizer::global_fix(const GlobalFix& fix) {
-  Impl& m = *impl_;
-  ++m.counts.global_fixes;
-  if (!m.ekf.initialized()) {
-    try {
-      // The odometry read since the fix's capture moves it to the latest reading.
-      Stamp at = fix.stamp;
-      Pose2 pose = fix.pose;
-      if (!m.odometry.empty() && m.odometry.last_stamp() > fix.stamp) {
-        at = m.odometry.last_stamp();
-        pose = fix.pose * m.odometry.at(fix.stamp).between(m.odometry.last());
-      }
-      m.ekf.initialize(at, pose, fix.covariance);
-    } catch (const InputError&) {
-      ++m.counts.fixes_refused;
-      return false;
-    }
-  } else if (m.ekf.restart_at(fix.stamp, fix.pose, fix.covariance)) {
-    ++m.counts.fixes_refused;
-    return false;
-  }
-  m.monitor.reset();
-  if (m.pipeline) m.pipeline->reset();
-  m.calibration.forget_measurements();
-  m.hypotheses->clear();
-  m.set_mode(LocalizerMode::relocalized, ModeCause::global_fix,
-             "global fix" + (fix.source.empty() ? std::string() : " from " + fix.source));
-  return true;
+  impl_->evidence = fix.stamp;
+  return impl_->apply_fix(fix);
 }
 
 LocalizerEstimate Localizer::estimate() const {

@@ -3,6 +3,7 @@
 // Every figure in docs and bench/ is one of these.
 
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <sstream>
 
 #include "lampnav/evaluation/replay.hpp"
@@ -53,9 +54,11 @@ Scripted make_run(const Drive& drive, double seconds, F published, bool with_tru
   return run;
 }
 
-// The localizer's mode changes, as replay keeps them.
-void event(Scripted& run, double t, LocalizerMode mode, ModeCause cause) {
-  run.result.events.push_back({at(t), mode, cause, "by hand"});
+// The localizer's mode changes, as replay keeps them: at `t`, on an input captured at
+// `evidence` (t when not given).
+void event(Scripted& run, double t, LocalizerMode mode, ModeCause cause,
+           std::optional<double> evidence = std::nullopt) {
+  run.result.events.push_back({at(t), mode, cause, "by hand", at(evidence.value_or(t))});
 }
 
 using Published = std::pair<LocalizerMode, double>;
@@ -145,6 +148,34 @@ TEST(Score, CarriedAgainWhileLostIsScoredFromTheFixThatEndsBoth) {
   EXPECT_EQ(m.wrong_fixes, 0);
   EXPECT_EQ(m.position_error_m.n, 50u + 46u);  // before the first carry, and from 10.5 s
   EXPECT_NEAR(m.position_error_m.max, 0.3, 1e-9);
+}
+
+// A fix made from a frame captured before the carry and published after it (the omni frame
+// arrives half a second late) knew nothing of the carry, as the tracking poses after a carry
+// know nothing of it until the localizer sees it: excused with the carry until the localizer
+// notices. The same fix made from a frame after the carry is a wrong fix.
+TEST(Score, AFixFromAFrameCapturedBeforeACarryIsExcusedWithTheCarry) {
+  for (const double evidence : {4.9, 5.2}) {
+    Drive drive;
+    drive.kidnap_at = 5.0;
+    Scripted run = make_run(drive, 12.0, [](double t) -> Published {
+      if (t < 4.0 - 1e-9) return {LocalizerMode::ambiguous, 0.0};
+      if (t < 5.5 - 1e-9) return {LocalizerMode::ambiguous, -10.0};
+      if (t < 6.5 - 1e-9) return {LocalizerMode::relocalized, -10.0};  // right before 5 s
+      if (t < 8.0 - 1e-9) return {LocalizerMode::lost, -10.0};
+      if (t < 8.5 - 1e-9) return {LocalizerMode::relocalized, 0.0};
+      return {LocalizerMode::tracking, 0.0};
+    });
+    event(run, 0.0, LocalizerMode::ambiguous, ModeCause::hypotheses_undecided);
+    event(run, 5.5, LocalizerMode::relocalized, ModeCause::global_fix, evidence);
+    event(run, 6.5, LocalizerMode::lost, ModeCause::moved_unseen, 5.6);
+    event(run, 8.0, LocalizerMode::relocalized, ModeCause::global_fix, 7.5);
+    event(run, 8.5, LocalizerMode::tracking, ModeCause::confirmed);
+    const Metrics m = score(run.result, run.log);
+    EXPECT_EQ(m.wrong_fixes, evidence < 5.0 ? 0 : 1) << "evidence at " << evidence << " s";
+    EXPECT_EQ(m.recoveries, 1);
+    EXPECT_NEAR(m.relocalization_latency_s.max, evidence < 5.0 ? 3.0 : 0.5, 1e-9);
+  }
 }
 
 TEST(Score, AKidnapTheLocalizerNeverNoticesIsAWrongFixAfterTenSeconds) {

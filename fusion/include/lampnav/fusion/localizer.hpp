@@ -108,6 +108,9 @@ struct LocalizerEvent {
   LocalizerMode mode;
   ModeCause cause;     // what programs act on
   std::string reason;  // the same for a person, with the evidence's figures
+  // Capture time of the input it rests on (the frame, wheel reading or fix being taken in): a
+  // fix made from a frame captured before the robot was carried knew nothing of the carry.
+  Stamp evidence;
 };
 
 // Inputs the localizer did not use, by reason (besides the EKF's own refusals).
