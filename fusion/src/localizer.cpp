@@ -234,7 +234,10 @@ struct Localizer::Impl {
   }
 
   // While tracking: the omni frame's lamps, matched near the estimate, as a pose measurement.
-  void omni_update(Stamp stamp, const FilterState& prior) {
+  // `checked`: the omni check judged the frame consistent; an update the check could not judge
+  // that the filter's gate refuses is not taken as evidence of a kidnap (its matches are the
+  // doubtful part).
+  void omni_update(Stamp stamp, const FilterState& prior, bool checked) {
     const double sp = std::clamp(std::sqrt(std::max(prior.P(0, 0), prior.P(1, 1))), 0.05, 0.5);
     const double sy = std::clamp(std::sqrt(prior.P(2, 2)), 0.5 * kDeg, 5 * kDeg);
     const std::optional<PoseHypothesis> h = global->refine(prior.pose(), sp, sy, last_omni);
@@ -245,7 +248,8 @@ struct Localizer::Impl {
     R.diagonal() += Eigen::Vector3d(0.06 * 0.06, 0.06 * 0.06, std::pow(0.15 * kDeg, 2));
     const UpdateResult u = ekf.update(stamp, h->pose, R);
     if (u.applied() || u.status == UpdateResult::Status::pending) ++counts.omni_updates;
-    if (u.applied() || u.refusal == Refusal::gated) lose(monitor.innovation(u.mahalanobis2));
+    if (u.applied() || (checked && u.refusal == Refusal::gated))
+      lose(monitor.innovation(u.mahalanobis2));
   }
 
   // A frame captured before the dead reckoning's first reading (the start, or odometry that stopped
@@ -516,8 +520,9 @@ void Localizer::omni_detection(Stamp stamp, const vision::OmniDetection& detecti
   m.lose(loss);
   if (m.unsure()) {
     m.relocalize(stamp);  // the frame that showed the loss shows where the robot is
-  } else if (r.conclusive && r.consistent && m.o.omni_update_min_lamps > 0) {
-    m.omni_update(stamp, *prior);
+  } else if (m.o.omni_update_min_lamps > 0 &&
+             (r.conclusive ? r.consistent : m.o.omni_update_unchecked)) {
+    m.omni_update(stamp, *prior, r.conclusive);
   }
 }
 

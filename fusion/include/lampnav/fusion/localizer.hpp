@@ -62,6 +62,12 @@ struct LocalizerOptions {
   // While tracking, a consistent omni frame refines the estimate's pose on the lamps it matched
   // and is applied as a measurement (at least this many lamps; 0 turns it off).
   int omni_update_min_lamps = 4;
+  // The same when the omni check cannot judge the frame (fewer than its min_expected lamps within
+  // its 75 degrees: round lamps 4.5 m apart, panels 3 m apart, a corridor's end). The refinement
+  // matches lamps out to 88 degrees, and where the wheels alone carried the heading 8 degrees off
+  // over 9 m between discs it holds it (docs/localization.md). Such an update that the filter's
+  // gate refuses is not counted as a kidnap's evidence.
+  bool omni_update_unchecked = true;
   // One omni check that disagrees with the estimate is not yet a loss (people hide lamps). It is
   // when the same frame locates the robot elsewhere (farther than second_opinion_distance) with
   // this likelihood ratio over the estimate, both scored alike: the frame then proves the jump
