@@ -134,9 +134,13 @@ ContinuityVerdict CeilingContinuity::frame(Stamp stamp,
   }
   if (now.lamps.empty() || odometry.empty()) return v;
   if (m.anchor && stamp <= m.anchor->stamp) return v;  // out of order: neither compared nor kept
-  if (!m.anchor || !m.comparable(*m.anchor, stamp, odometry)) {
-    m.anchor = std::move(now);
+  // The frame becomes the one later frames are held against.
+  const auto anchor_on = [&m](Sighting& s) {
+    m.anchor = std::move(s);
     m.odd.reset();
+  };
+  if (!m.anchor || !m.comparable(*m.anchor, stamp, odometry)) {
+    anchor_on(now);
     return v;
   }
   const Agreement a = m.compare(*m.anchor, now, odometry);
@@ -146,8 +150,7 @@ ContinuityVerdict CeilingContinuity::frame(Stamp stamp,
   v.appeared = a.appeared;
   v.vanished = a.vanished;
   if (!a.odd()) {
-    m.anchor = std::move(now);
-    m.odd.reset();
+    anchor_on(now);
     return v;
   }
   v.odd = true;
@@ -162,8 +165,7 @@ ContinuityVerdict CeilingContinuity::frame(Stamp stamp,
                   v.vanished, v.vanished > 1 ? "s" : "", to_seconds(stamp - m.anchor->stamp),
                   v.appeared);
     v.why = why;
-    m.anchor = std::move(now);
-    m.odd.reset();
+    anchor_on(now);
     return v;
   }
   m.odd = std::move(now);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "ceiling_rays.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/vision/camera_models.hpp"
 
@@ -84,8 +85,9 @@ struct Localizer::Impl {
       ceiling_model.emplace(*ceiling_camera);
       ceiling_geometry.emplace(*ceiling_camera);
       ceiling_kind = shape_prior_for(m, *ceiling_camera);
-      const std::optional<double> z = usual_lamp_height(m);
-      if (o.continuity.enabled && z) continuity.emplace(*ceiling_camera, *z, o.continuity);
+      // The map's median lamp height above the floor (0 for a map without lamps).
+      const double z = detail::usual_lamp_height(m, 0.0);
+      if (o.continuity.enabled && z > 0) continuity.emplace(*ceiling_camera, z, o.continuity);
     }
     if (const CameraDescription* c = robot.find_camera("omni_camera")) {
       omni_detector.emplace(*c, o.omni_detector);
@@ -93,16 +95,6 @@ struct Localizer::Impl {
       global.emplace(m, *c, o.global);
     }
     hypotheses.emplace(m, ceiling_camera, global ? &*global : nullptr, o.ceiling, o.hypotheses);
-  }
-
-  // The median height of the map's lamps; none for a map without lamps.
-  static std::optional<double> usual_lamp_height(const graph::TopologicalMap& m) {
-    std::vector<double> z;
-    for (const graph::Node& n : m.nodes())
-      for (const graph::Lamp& l : n.lamps) z.push_back(l.xyz.z());
-    if (z.empty()) return std::nullopt;
-    std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
-    return z[z.size() / 2];
   }
 
   static LocalizerOptions fix_semi_axis(LocalizerOptions opt, const RobotDescription& robot) {
@@ -353,11 +345,14 @@ struct Localizer::Impl {
     }
     lose(monitor.ceiling(e));
   }
-  void check_continuity(const CeilingObservation& ob) {
-    if (!continuity) return;
+  static std::vector<vision::LampDetection> detections(const CeilingObservation& ob) {
     std::vector<vision::LampDetection> lamps;
     for (const auto& l : ob.lamps) lamps.push_back(l.detection);
-    const ContinuityVerdict v = continuity->frame(ob.stamp, lamps, odometry);
+    return lamps;
+  }
+  void check_continuity(Stamp stamp, const std::vector<vision::LampDetection>& lamps) {
+    if (!continuity) return;
+    const ContinuityVerdict v = continuity->frame(stamp, lamps, odometry);
     if (v.broken) moved_unseen(v);
   }
 
@@ -390,11 +385,10 @@ struct Localizer::Impl {
       last_ceiling = process(pose, P);
       ++counts.ceiling_frames;
       ++counts.frames_while_lost;
-      check_continuity(last_ceiling);
+      const std::vector<vision::LampDetection> lamps = detections(last_ceiling);
+      check_continuity(stamp, lamps);
       if (hypotheses->hypotheses().empty()) return last_ceiling;
       if (before_odometry(stamp) || before_move(stamp)) return last_ceiling;
-      std::vector<vision::LampDetection> lamps;
-      for (const auto& l : last_ceiling.lamps) lamps.push_back(l.detection);
       hypotheses->ceiling(stamp, lamps, odometry);
       settle(stamp);
       return last_ceiling;
@@ -405,7 +399,7 @@ struct Localizer::Impl {
       return last_ceiling;
     }
     last_ceiling = process(prior->pose(), prior->P);
-    check_continuity(last_ceiling);
+    check_continuity(stamp, detections(last_ceiling));
     observe(last_ceiling, *prior);
     return last_ceiling;
   }

@@ -2,6 +2,7 @@
 // by robot.json's ceiling camera, floor bumps drawn at the pipeline's tilt, and lifts the wheels
 // do not see.
 
+#include <iostream>
 #include <random>
 
 #include "lampnav/fusion/ceiling_continuity.hpp"
@@ -73,7 +74,7 @@ Stamp at(int step) { return Stamp(std::chrono::milliseconds(100 * step)); }
 
 TEST(CeilingContinuity, SteadyDriveUnderBumpsNeverBreaks) {
   // Five minutes (150 m) of bumps at the pipeline's tilt, with a stretch of dark frames and a
-  // lamp that fails halfway and one that comes on: odd frames happen, a move is never seen.
+  // lamp that fails halfway and one that comes on: odd frames may happen, a move is never seen.
   Drive drive(1);
   OdometryTrack odometry(0.2);
   CeilingContinuity c(ceiling_camera(), kLampZ);
@@ -96,9 +97,10 @@ TEST(CeilingContinuity, SteadyDriveUnderBumpsNeverBreaks) {
     odd += v.odd;
     compared += v.compared;
   }
+  std::cout << odd << " odd frames of " << compared << " compared\n";
   EXPECT_GT(lamps, 3000);
   EXPECT_GT(compared, 2500);
-  EXPECT_LE(odd, 15);  // about 0.2 % of the frames with one lamp in view
+  EXPECT_LE(odd, 15);  // none on this drive; 131 over the 103 wing drives of the docs
 }
 
 TEST(CeilingContinuity, LiftSeenInTwoFramesThatAgree) {

@@ -34,8 +34,9 @@ struct CeilingContinuityOptions {
   double tilt_sigma = 0.0087;  // the ceiling pipeline's (half a degree)
   double sigma_m = 0.01;
   double gate_sigmas = 3.5;
-  // Plus this per metre travelled between the two frames: the lamps' height, taken as the map's
-  // usual one, is off by up to a fifth for a room's lamp; the heading drifts.
+  // Plus this per metre travelled between the two frames: a lamp hung at another height than the
+  // map's usual one (it errs by the travel times the height's relative error), the heading's
+  // drift.
   double gate_per_m = 0.25;
   // Frames further apart than this (m of the wheels' travel, turning included) are not compared:
   // the gate would cover the spacing of lamps.
