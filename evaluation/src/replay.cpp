@@ -11,6 +11,7 @@
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/ekf.hpp"
+#include "lampnav/fusion/odometry_calibration.hpp"
 #include "lampnav/internal/json_util.hpp"
 
 namespace lampnav::evaluation {
@@ -139,6 +140,21 @@ void note_input_faults(ReplayResult& r, const fusion::LocalizerCounts& c) {
                       " frames captured before the filter's history (too late to apply)");
 }
 
+// What the lamps taught the localizer of the wheels: odometry whose wheel radius is off shows here,
+// for the user to mend at its source (the localizer corrects it as it drives either way).
+void note_wheels(ReplayResult& r, const fusion::OdometryCalibration& c) {
+  constexpr int kEnough = 50;  // pairs of positions
+  if (c.travel_pairs() < kEnough) return;
+  const double travel = 1 / (1 + c.travel_scale()) - 1;  // how much longer the wheels read
+  std::string line = "the wheels, learnt from the lamps: travel read " +
+                     one_decimal(std::fabs(travel) * 100) + " % " +
+                     (travel >= 0 ? "long" : "short") + ", heading drift " +
+                     one_decimal(c.yaw_drift_per_m() * 180 / M_PI) + " deg a metre";
+  if (std::fabs(travel) >= 0.01)
+    line += " (the wheel radius giving the travel is off by about that)";
+  r.notes.push_back(line);
+}
+
 }  // namespace
 
 ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
@@ -180,6 +196,7 @@ ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   for (const auto& p : robot_in.problems()) r.notes.push_back("skipped " + p);
   note_input_faults(r, rt.localizer().counts());
+  note_wheels(r, rt.localizer().calibration());
   const auto& ev = rt.localizer().events();
   for (const auto& e : ev)
     if (e.cause != fusion::ModeCause::initialized) r.events.push_back(e);

@@ -175,6 +175,26 @@ TEST(Cli, SimStoresFramesInTheFormatAsked) {
   }
 }
 
+// A robot whose wheels read every metre 3 % long: the replay's notes say what the lamps taught
+// the localizer, and that the wheel radius giving the travel is off.
+TEST(Cli, ReplaySaysWhatTheLampsTaughtOfTheWheels) {
+  const auto dir =
+      std::filesystem::temp_directory_path() / ("lampnav_cli_wheels_" + std::to_string(::getpid()));
+  const std::string log = (dir / "long.mcap").string();
+  std::filesystem::create_directories(dir);
+  const Result sim = run("sim --scenario corridor --wheel-scale 0.03,0.03 -q -o '" + log + "'");
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  const Result r = run("replay '" + log + "' -q --out '" + (dir / "out").string() + "'");
+  EXPECT_EQ(r.status, 0) << r.err;
+  const std::size_t at = r.err.find("the wheels, learnt from the lamps: travel read ");
+  ASSERT_NE(at, std::string::npos) << r.err;
+  const double percent = std::stod(r.err.substr(at + 47));
+  EXPECT_NEAR(percent, 3.0, 0.3) << r.err;
+  EXPECT_THAT(r.err.substr(at), HasSubstr("% long"));
+  EXPECT_THAT(r.err.substr(at), HasSubstr("wheel radius giving the travel is off"));
+  std::filesystem::remove_all(dir);
+}
+
 // The fixture: the museum seen from (8.0, -2.5) facing 34.4 degrees (0.6 rad), floor tilted by
 // (0.23, -0.34) degrees, rendered by sim::OmniRenderer without pixel noise.
 std::string locate_args(const std::string& image) {
