@@ -331,8 +331,8 @@ struct Localizer::Impl {
       if (r.applied() || r.status == UpdateResult::Status::pending) {
         ++counts.measurements_applied;
         // One round lamp measures no heading, and its position (2.6 cm of noise under a 2.8 m
-        // ceiling's discs) set the travel 1.2 % off on wheels that were right: the wheels learn
-        // from poses only (docs/localization.md, "The wheels' travel").
+        // ceiling's discs) set the travel 0.8 to 1.5 % off on wheels that were right: the wheels
+        // learn from poses only (docs/localization.md, "The wheels' travel").
         if (r.applied() && ob.measurement->heading_measured) {
           const PoseMeasurement& pm = *ob.measurement;
           calibration.heading(pm.stamp, pm.pose.yaw(), pm.covariance(2, 2));

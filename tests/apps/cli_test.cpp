@@ -186,9 +186,10 @@ TEST(Cli, ReplaySaysWhatTheLampsTaughtOfTheWheels) {
   ASSERT_EQ(sim.status, 0) << sim.err;
   const Result r = run("replay '" + log + "' -q --out '" + (dir / "out").string() + "'");
   EXPECT_EQ(r.status, 0) << r.err;
-  const std::size_t at = r.err.find("the wheels, learnt from the lamps: travel read ");
+  const std::string said = "the wheels, learnt from the lamps: travel read ";
+  const std::size_t at = r.err.find(said);
   ASSERT_NE(at, std::string::npos) << r.err;
-  const double percent = std::stod(r.err.substr(at + 47));
+  const double percent = std::stod(r.err.substr(at + said.size()));
   EXPECT_NEAR(percent, 3.0, 0.3) << r.err;
   EXPECT_THAT(r.err.substr(at), HasSubstr("% long"));
   EXPECT_THAT(r.err.substr(at), HasSubstr("wheel radius giving the travel is off"));
