@@ -5,6 +5,7 @@
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/core/pose2.hpp"
+#include "lampnav/fusion/ekf.hpp"
 
 namespace lampnav::fusion {
 
@@ -32,12 +33,15 @@ OdometryCalibration::OdometryCalibration(const OdometryCalibrationOptions& optio
 
 void OdometryCalibration::wheels(Stamp t, double dl, double dr) {
   const double ds = (dl + dr) / 2, dth = (dr - dl) / (2 * o_.semi_axis);
-  // The way is dead-reckoned along the heading as corrected so far, so that the wheels' own turn
-  // does not bend it: its length between two positions is then the raw travel's.
-  const double turn = (dth + drift_ * ds) / (1 - scale_);
-  x_ += ds * std::cos(heading_ + turn / 2);
-  y_ += ds * std::sin(heading_ + turn / 2);
-  heading_ = wrap_angle(heading_ + turn);
+  // The way is dead-reckoned (the EKF's motion model) with the raw travel along the heading as
+  // corrected so far, so that the wheels' own turn does not bend it: its length between two
+  // positions is then the raw travel's.
+  const double turn = (dth + drift_ * ds) / (1 - scale_), a = o_.semi_axis;
+  const StateVector way =
+      predict_motion(StateVector(x_, y_, heading_), ds - a * turn, ds + a * turn, a);
+  x_ = way.x();
+  y_ = way.y();
+  heading_ = way.z();
   s_ += ds;
   r_ += dth;
   odo_.push_back({t, s_, r_, x_, y_});
