@@ -155,6 +155,20 @@ void note_wheels(ReplayResult& r, const fusion::OdometryCalibration& c) {
   r.notes.push_back(line);
 }
 
+// The floor's swing the ceiling frames showed, when it is past what the models assume: a rough
+// floor or a loose mount, for the user to know (the localizer weighs its lamps for it while it
+// knows where the robot is, either way).
+void note_swing(ReplayResult& r, const fusion::CeilingContinuity* c,
+                const fusion::CeilingContinuityOptions& o) {
+  if (!c || !c->learnt_tilt_sigma() || c->tilt_sigma() <= o.tilt_sigma) return;
+  r.notes.push_back("the floor swings the ceiling camera by " +
+                    one_decimal(*c->learnt_tilt_sigma() * 180 / M_PI) +
+                    " deg from frame to frame (the localizer's models assume " +
+                    one_decimal(o.tilt_sigma * 180 / M_PI) +
+                    "): the lamps were weighed for it while the robot's place was known; " +
+                    std::to_string(c->tilt_samples()) + " lamps seen twice measured it");
+}
+
 }  // namespace
 
 ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
@@ -197,6 +211,7 @@ ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
   for (const auto& p : robot_in.problems()) r.notes.push_back("skipped " + p);
   note_input_faults(r, rt.localizer().counts());
   note_wheels(r, rt.localizer().calibration());
+  note_swing(r, rt.localizer().continuity(), options.runtime.localizer.continuity);
   const auto& ev = rt.localizer().events();
   for (const auto& e : ev)
     if (e.cause != fusion::ModeCause::initialized) r.events.push_back(e);

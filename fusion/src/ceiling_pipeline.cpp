@@ -67,6 +67,13 @@ LampLabeller::LampLabeller(const graph::TopologicalMap& map, const CameraDescrip
              std::hypot(camera.mount.xyz.x(), camera.mount.xyz.y()) + 1.0;
 }
 
+void LampLabeller::set_tilt_sigma(double rad) {
+  LabellerOptions o = o_;
+  o.tilt_sigma = rad;
+  o.validate();
+  o_ = o;
+}
+
 std::vector<const graph::Lamp*> LampLabeller::candidates(const Pose2& predicted) const {
   const graph::Node* here = map_->node_containing(predicted.translation());
   if (!here) return map_->lamps_within(predicted.translation(), o_.candidate_radius);
@@ -221,6 +228,7 @@ struct CeilingPipeline::Impl {
   CeilingGeometry geometry;
   vision::PinholeCamera model;
   std::map<int, const graph::Lamp*> label_of_track;
+  double measurement_tilt;  // the pose measurement's tilt spread (set_floor_swing)
 
   // Labels a frame's lamps and measures the pose; `tracked`: a track keeps its label.
   CeilingObservation label(Stamp stamp, const vision::TrackedFrame& frame, const Pose2& predicted,
@@ -233,7 +241,8 @@ struct CeilingPipeline::Impl {
         tracker(c, shape_prior_for(m, c), opt.detector, opt.tracker),
         labeller(m, c, opt.labeller),
         geometry(c),
-        model(c) {
+        model(c),
+        measurement_tilt(opt.measurement.tilt_sigma) {
     o.validate();
   }
 };
@@ -242,6 +251,14 @@ CeilingPipeline::CeilingPipeline(const graph::TopologicalMap& map, const CameraD
                                  const CeilingPipelineOptions& options)
     : impl_(std::make_unique<Impl>(map, camera, options)) {}
 CeilingPipeline::~CeilingPipeline() = default;
+
+void CeilingPipeline::set_floor_swing(double rad) {
+  if (!(rad >= 0 && rad < 0.5))
+    throw InputError({"", "ceiling pipeline", "floor swing"}, "must be 0 to 0.5 rad");
+  Impl& m = *impl_;
+  m.labeller.set_tilt_sigma(std::max(m.o.labeller.tilt_sigma, rad));
+  m.measurement_tilt = std::max(m.o.measurement.tilt_sigma, rad);
+}
 CeilingPipeline::CeilingPipeline(CeilingPipeline&&) noexcept = default;
 
 void CeilingPipeline::reset() {
@@ -301,8 +318,10 @@ CeilingObservation CeilingPipeline::Impl::label(Stamp stamp, const vision::Track
   }
   if (!labelled.empty()) {
     std::string why;
-    out.measurement = measure_pose(geometry, model, labelled, predicted, stamp, o.measurement, &why,
-                                   &out.no_measurement);
+    PoseMeasurementOptions mo = o.measurement;
+    mo.tilt_sigma = measurement_tilt;
+    out.measurement =
+        measure_pose(geometry, model, labelled, predicted, stamp, mo, &why, &out.no_measurement);
     if (!out.measurement) out.no_measurement_reason = why;
   } else if (!out.lamps.empty()) {
     out.no_measurement_reason = "no labelled lamp in full view";

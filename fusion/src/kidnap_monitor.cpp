@@ -51,6 +51,7 @@ OmniCheck::OmniCheck(const graph::TopologicalMap& map, const CameraDescription& 
       mount_R_(camera.mount.rotation()),
       mount_t_(camera.mount.xyz),
       o_(options),
+      configured_tilt_deg_(options.tilt_sigma_deg),
       lamp_height_(detail::usual_lamp_height(map, camera.mount.xyz.z())),
       min_blob_per_cos_(detail::spurious_blob_limit(map, camera.mount.xyz.z())) {
   o_.validate();
@@ -163,6 +164,12 @@ OmniCheckResult OmniCheck::check(const Pose2& pose, const Eigen::Matrix3d& P,
   r.consistent = (!lamp_side || r.match_fraction() >= o_.min_match_fraction) &&
                  (!blob_side || r.explained_fraction() >= o_.min_match_fraction);
   return r;
+}
+
+void OmniCheck::scale_tilt(double factor) {
+  if (!(factor >= 1 && std::isfinite(factor)))
+    throw InputError({"", "omni check", "tilt factor"}, "must be at least 1");
+  o_.tilt_sigma_deg = configured_tilt_deg_ * factor;
 }
 
 KidnapMonitor::KidnapMonitor(const KidnapMonitorOptions& options) : o_(options) {

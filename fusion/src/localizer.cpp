@@ -49,6 +49,9 @@ struct Localizer::Impl {
   std::optional<CeilingGeometry> ceiling_geometry;
   std::optional<vision::LampShapePrior> ceiling_kind;  // the lamps the ceiling camera looks for
   std::optional<CeilingContinuity> continuity;  // moves the ceiling camera saw and the wheels not
+  // The tilt spread the continuity check learnt (or the configured one), given to the models
+  // that follow a known pose, and the one the kidnap monitor's evidence was weighed with.
+  double floor_swing = 0, weighed_swing = 0;
   // Frames captured before this weigh no hypothesis: the robot was moved after them (a move the
   // ceiling camera saw), and the dead reckoning cannot carry them across it.
   std::optional<Stamp> moved_after;
@@ -79,6 +82,7 @@ struct Localizer::Impl {
         monitor(o.kidnap),
         odometry(robot.semi_axis) {
     o.validate();
+    floor_swing = weighed_swing = o.continuity.tilt_sigma;
     const CameraDescription* ceiling_camera = robot.find_camera("ceiling_camera");
     if (ceiling_camera) {
       pipeline.emplace(m, *ceiling_camera, o.ceiling);
@@ -358,7 +362,27 @@ struct Localizer::Impl {
   }
   void check_continuity(Stamp stamp, const std::vector<vision::LampDetection>& lamps) {
     if (!continuity) return;
-    const ContinuityVerdict v = continuity->frame(stamp, lamps, odometry);
+    // While the robot is looked for, a move must not hide in the floor's swing: the gates stay
+    // as configured there (a false alarm then costs the hypotheses a few frames, never a pose).
+    const ContinuityVerdict v = continuity->frame(stamp, lamps, odometry, unsure());
+    // The floor's swing as the frames show it: the models that follow a known pose weigh the
+    // lamps with it (labelling, the pose measurement, the omni check, scaled alike: the omni
+    // camera rides the same base). The hypotheses keep the configured models: weighed for the
+    // swing they made wrong fixes in a regular building (docs/localization.md).
+    const double swing = continuity->tilt_sigma();
+    if (swing != floor_swing) {
+      floor_swing = swing;
+      pipeline->set_floor_swing(swing);
+      const double configured = o.continuity.tilt_sigma;
+      if (omni_check)
+        omni_check->scale_tilt(configured > 0 ? std::max(1.0, swing / configured) : 1.0);
+    }
+    // The kidnap monitor's windows were weighed for a steadier floor than there is: once the
+    // swing has grown by a quarter over the one they were weighed with, they start again.
+    if (floor_swing > 1.25 * weighed_swing) {
+      weighed_swing = floor_swing;
+      monitor.reset();
+    }
     if (v.broken) moved_unseen(v);
   }
 
@@ -564,6 +588,10 @@ const std::vector<LocalizerEvent>& Localizer::events() const { return impl_->eve
 const LocalizerCounts& Localizer::counts() const { return impl_->counts; }
 const KidnapMonitor::Counts& Localizer::kidnap_counts() const { return impl_->monitor.counts(); }
 const PoseEkf& Localizer::filter() const { return impl_->ekf; }
+const CeilingContinuity* Localizer::continuity() const {
+  return impl_->continuity ? &*impl_->continuity : nullptr;
+}
+
 const OdometryCalibration& Localizer::calibration() const { return impl_->calibration; }
 bool Localizer::has_ceiling_camera() const { return impl_->pipeline.has_value(); }
 bool Localizer::has_omni_camera() const { return impl_->omni_detector.has_value(); }

@@ -27,13 +27,14 @@ CameraDescription ceiling_camera() {
 // gives where the robot is (a lift moves it; the wheels go on as if not).
 class Drive {
  public:
-  explicit Drive(std::uint32_t seed) : rng_(seed), geometry_(ceiling_camera()), model_(camera_) {}
+  explicit Drive(std::uint32_t seed, double tilt = kTilt)
+      : rng_(seed), tilt_(tilt), geometry_(ceiling_camera()), model_(camera_) {}
 
   // The frame at step k (0.1 s each), its lamps seen from `pose` with a bump; `lit(x)` says
   // whether the lamp at x lights.
   template <class Lit>
   std::vector<vision::LampDetection> frame(const Pose2& pose, Lit lit) {
-    std::normal_distribution<double> bump(0, kTilt);
+    std::normal_distribution<double> bump(0, tilt_);
     const Vector2d tilt(bump(rng_), bump(rng_));
     std::vector<vision::LampDetection> lamps;
     for (double x = -kSpacing * 40; x < kSpacing * 200; x += kSpacing) {
@@ -65,6 +66,7 @@ class Drive {
  private:
   CameraDescription camera_ = ceiling_camera();
   std::mt19937 rng_;
+  double tilt_;
   CeilingGeometry geometry_;
   vision::PinholeCamera model_;
   Stamp wheel_t_{};
@@ -177,6 +179,50 @@ TEST(CeilingContinuity, LiftAfterDarkFramesIsSeen) {
   EXPECT_TRUE(seen);
 }
 
+TEST(CeilingContinuity, LearnsHowMuchTheFloorSwings) {
+  // A minute's drive with the camera swung by each frame's own tilt: the lamps seen twice measure
+  // it. As steady as configured, the configured spread stays; swung three and four times as
+  // much, the spread learnt takes its place (and the gates widen: no move is seen once it is).
+  for (const double swing : {0.5, 1.5, 2.0}) {
+    const double tilt = swing * M_PI / 180;
+    Drive drive(7, tilt);
+    OdometryTrack odometry(0.2);
+    CeilingContinuity c(ceiling_camera(), kLampZ);
+    int broken = 0, learnt_at = -1;  // moves seen once the swing is learnt; the frame it was
+    for (int k = 0; k < 600; ++k) {
+      drive.wheels_to(at(k), odometry);
+      const bool b = c.frame(at(k), drive.frame(Pose2(0.05 * k, 0, 0)), odometry).broken;
+      if (learnt_at < 0 && c.learnt_tilt_sigma()) learnt_at = k;
+      broken += b && learnt_at >= 0;
+    }
+    EXPECT_LE(learnt_at, 60) << swing;  // 50 lamps seen twice: within 6 s
+    ASSERT_TRUE(c.learnt_tilt_sigma()) << swing;
+    std::cout << "swing " << swing << " deg: learnt " << *c.learnt_tilt_sigma() * 180 / M_PI
+              << " deg from " << c.tilt_samples() << " lamps\n";
+    EXPECT_NEAR(*c.learnt_tilt_sigma(), tilt, 0.1 * tilt) << swing;
+    EXPECT_EQ(c.tilt_samples(), CeilingContinuityOptions{}.tilt_window);
+    if (swing < 1)
+      EXPECT_EQ(c.tilt_sigma(), kTilt);
+    else
+      EXPECT_EQ(c.tilt_sigma(), *c.learnt_tilt_sigma());
+    EXPECT_EQ(broken, 0) << swing;
+    c.reset();  // a carry: the floor is the same
+    EXPECT_EQ(c.tilt_samples(), CeilingContinuityOptions{}.tilt_window);
+  }
+  // Not learnt: the configured spread, whatever the floor does.
+  CeilingContinuityOptions o;
+  o.learn_tilt = false;
+  Drive drive(7, 2 * M_PI / 180);
+  OdometryTrack odometry(0.2);
+  CeilingContinuity c(ceiling_camera(), kLampZ, o);
+  for (int k = 0; k < 600; ++k) {
+    drive.wheels_to(at(k), odometry);
+    c.frame(at(k), drive.frame(Pose2(0.05 * k, 0, 0)), odometry);
+  }
+  EXPECT_FALSE(c.learnt_tilt_sigma());
+  EXPECT_EQ(c.tilt_sigma(), kTilt);
+}
+
 TEST(CeilingContinuity, BadOptionsAreRefusedByName) {
   const auto refused = [](const CeilingContinuityOptions& o, double z = kLampZ) -> std::string {
     try {
@@ -197,6 +243,18 @@ TEST(CeilingContinuity, BadOptionsAreRefusedByName) {
   o.max_travel_m = std::nan("");
   EXPECT_THAT(refused(o), testing::HasSubstr("max_travel_m"));
   EXPECT_THAT(refused({}, 0.1), testing::HasSubstr("lamp_height"));  // below the camera
+  o = {};
+  o.tilt_min_samples = o.tilt_window + 1;
+  EXPECT_THAT(refused(o), testing::HasSubstr("tilt_min_samples"));
+  o = {};
+  o.tilt_margin = 0.9;
+  EXPECT_THAT(refused(o), testing::HasSubstr("tilt_margin"));
+  o = {};
+  o.max_tilt_sigma = 0.5 * o.tilt_sigma;
+  EXPECT_THAT(refused(o), testing::HasSubstr("max_tilt_sigma"));
+  o = {};
+  o.tilt_match_m = -1;
+  EXPECT_THAT(refused(o), testing::HasSubstr("tilt_match_m"));
 }
 
 }  // namespace

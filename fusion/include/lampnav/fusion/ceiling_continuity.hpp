@@ -16,6 +16,7 @@
 // before it (the lamps moved, and stayed where they moved to).
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,7 +46,28 @@ struct CeilingContinuityOptions {
   // least this fraction of the image's width and height inside the image: there a lamp is in
   // full view or completed (docs/ceiling-pipeline.md), not cut down to a sliver.
   double margin = 0.15;
-  void validate() const;  // throws InputError naming the field
+  // The floor's swing, learnt from the frames. A lamp seen in two frames a few centimetres of
+  // travel apart, carried between them by the wheels, lies off itself by the difference of the
+  // two frames' tilts (through the lens: ceiling_geometry.hpp), whatever the map. The median of
+  // those offsets over the last `tilt_window` lamps, each normalized by its spread for a tilt of
+  // one radian (a chi-square of 2 degrees of freedom times the tilt's variance), gives the tilt's
+  // spread as the camera's models take it (a base tilted about the floor also moves the camera:
+  // a lamp moves by its height above the floor times the tilt, 1.125 times what the turn of a
+  // camera 2.4 m under it alone would do, and the models need that). Once `tilt_min_samples`
+  // lamps hold it and it exceeds `tilt_sigma` by `tilt_margin` (a factor) and by twice its own
+  // standard error, it takes tilt_sigma's place in the gates here, up to max_tilt_sigma; the
+  // localizer gives it to its ceiling models and scales its omni models alike. The detection's
+  // own noise is in the offsets too, so the spread learnt is a little larger than the tilt's,
+  // never smaller. Only ever raised above tilt_sigma: a swing slow enough to move two frames
+  // alike is not seen this way, and the configured value stays the floor.
+  bool learn_tilt = true;
+  int tilt_window = 300;
+  int tilt_min_samples = 50;
+  double tilt_margin = 1.3;
+  double tilt_pair_travel_m = 0.1;  // frames further apart are not used (lamp heights differ)
+  double tilt_match_m = 0.5;        // a lamp's nearest in the other frame, within this, alone
+  double max_tilt_sigma = 0.07;     // rad (4 degrees)
+  void validate() const;            // throws InputError naming the field
 };
 
 struct ContinuityVerdict {
@@ -73,10 +95,20 @@ class CeilingContinuity {
   // The lamps (full and completed views; partial ones are left out) of a frame captured at
   // `stamp`, with the dead reckoning that covers it. A frame with no lamp, or captured before
   // the last one, changes nothing.
+  // `steady`: the gates take the configured tilt_sigma, whatever swing was learnt (the
+  // localizer while it looks for the robot: a move must not hide in the floor's swing there).
   ContinuityVerdict frame(Stamp stamp, const std::vector<vision::LampDetection>& lamps,
-                          const OdometryTrack& odometry);
-  // Forgets the last frame (the dead reckoning started again).
+                          const OdometryTrack& odometry, bool steady = false);
+  // Forgets the last frame (the dead reckoning started again). The swing learnt is kept: the
+  // floor and the mount are the same.
   void reset();
+
+  // The tilt spread (rad) the gates use: options.tilt_sigma, or the swing learnt once it holds.
+  double tilt_sigma() const;
+  // The swing learnt so far (rad) and how many lamps it rests on; nullopt before
+  // tilt_min_samples.
+  std::optional<double> learnt_tilt_sigma() const;
+  int tilt_samples() const;
 
  private:
   struct Impl;

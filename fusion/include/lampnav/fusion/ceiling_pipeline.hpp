@@ -54,6 +54,9 @@ class LampLabeller {
   LabelResult label(const vision::LampDetection& detection, const Pose2& predicted,
                     const Eigen::Matrix3d& covariance, const std::set<LampId>& taken = {}) const;
   std::vector<const graph::Lamp*> candidates(const Pose2& predicted) const;
+  // The floor bumps' tilt spread (rad), as learnt while driving (CeilingContinuity). Throws
+  // InputError outside [0, 0.5).
+  void set_tilt_sigma(double rad);
 
  private:
   const graph::TopologicalMap* map_;
@@ -124,6 +127,10 @@ class CeilingPipeline {
                              const Pose2& predicted, const Eigen::Matrix3d& covariance);
   // Forgets the tracks and their labels (after a kidnap: the old labels are worthless).
   void reset();
+  // The floor's swing learnt while driving (rad, CeilingContinuity): labelling and the pose
+  // measurement each take the larger of their configured tilt_sigma and this from now on.
+  // Throws InputError outside [0, 0.5).
+  void set_floor_swing(double rad);
 
  private:
   struct Impl;

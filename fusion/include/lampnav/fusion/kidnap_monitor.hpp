@@ -110,12 +110,17 @@ class OmniCheck {
             const OmniCheckOptions& options = {});
   OmniCheckResult check(const Pose2& pose, const Eigen::Matrix3d& covariance,
                         const std::vector<vision::OmniBlob>& blobs) const;
+  // The floor swings the camera `factor` (>= 1) times as much as configured (learnt while
+  // driving, CeilingContinuity): tilt_sigma_deg becomes the configured one times it. Throws
+  // InputError for a factor below 1 or not finite.
+  void scale_tilt(double factor);
 
  private:
   const graph::TopologicalMap* map_;
   Eigen::Matrix3d mount_R_;
   Eigen::Vector3d mount_t_;
   OmniCheckOptions o_;
+  double configured_tilt_deg_;
   std::vector<const graph::Lamp*> lamps_;
   double lamp_height_ = 0;  // the median lamp's above the camera, where a blob's ray meets the
                             // ceiling

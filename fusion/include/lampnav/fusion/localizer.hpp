@@ -191,6 +191,9 @@ class Localizer {
   const KidnapMonitor::Counts& kidnap_counts() const;
   const PoseEkf& filter() const;
   const OdometryCalibration& calibration() const;
+  // The ceiling frames held against one another (the floor's swing it learnt among them); null
+  // without a ceiling camera or with continuity off.
+  const CeilingContinuity* continuity() const;
   bool has_ceiling_camera() const;
   bool has_omni_camera() const;
 
