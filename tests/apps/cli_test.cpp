@@ -2,6 +2,7 @@
 
 #include <sys/wait.h>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -176,47 +177,48 @@ TEST(Cli, SimStoresFramesInTheFormatAsked) {
   }
 }
 
+// The corridor scenario recorded with `sim_flags` and replayed: the replay's result (its notes
+// on stderr). The files go with the call.
+Result replay_corridor(const std::string& name, const std::string& sim_flags) {
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("lampnav_cli_" + name + "_" + std::to_string(::getpid()));
+  const std::string log = (dir / "corridor.mcap").string();
+  std::filesystem::create_directories(dir);
+  const Result sim = run("sim --scenario corridor " + sim_flags + " -q -o '" + log + "'");
+  Result r = sim;
+  if (sim.status == 0) r = run("replay '" + log + "' -q --out '" + (dir / "out").string() + "'");
+  std::filesystem::remove_all(dir);
+  return r;
+}
+
+// The number right after `said` in `text`, or NaN when `said` is not there.
+double number_after(const std::string& text, const std::string& said) {
+  const std::size_t at = text.find(said);
+  return at == std::string::npos ? std::nan("") : std::stod(text.substr(at + said.size()));
+}
+
 // A robot whose wheels read every metre 3 % long: the replay's notes say what the lamps taught
 // the localizer, and that the wheel radius giving the travel is off.
 TEST(Cli, ReplaySaysWhatTheLampsTaughtOfTheWheels) {
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("lampnav_cli_wheels_" + std::to_string(::getpid()));
-  const std::string log = (dir / "long.mcap").string();
-  std::filesystem::create_directories(dir);
-  const Result sim = run("sim --scenario corridor --wheel-scale 0.03,0.03 -q -o '" + log + "'");
-  ASSERT_EQ(sim.status, 0) << sim.err;
-  const Result r = run("replay '" + log + "' -q --out '" + (dir / "out").string() + "'");
-  EXPECT_EQ(r.status, 0) << r.err;
+  const Result r = replay_corridor("wheels", "--wheel-scale 0.03,0.03");
+  ASSERT_EQ(r.status, 0) << r.err;
   const std::string said = "the wheels, learnt from the lamps: travel read ";
-  const std::size_t at = r.err.find(said);
-  ASSERT_NE(at, std::string::npos) << r.err;
-  const double percent = std::stod(r.err.substr(at + said.size()));
-  EXPECT_NEAR(percent, 3.0, 0.3) << r.err;
-  EXPECT_THAT(r.err.substr(at), HasSubstr("% long"));
-  EXPECT_THAT(r.err.substr(at), HasSubstr("wheel radius giving the travel is off"));
+  EXPECT_NEAR(number_after(r.err, said), 3.0, 0.3) << r.err;
+  EXPECT_THAT(r.err, HasSubstr("% long"));
+  EXPECT_THAT(r.err, HasSubstr("wheel radius giving the travel is off"));
   // The simulator's floor swings as the models assume: nothing said of it.
   EXPECT_THAT(r.err, Not(HasSubstr("the floor swings")));
-  std::filesystem::remove_all(dir);
 }
 
 // A floor that swings the cameras by 1.5 degrees from frame to frame (three times what the models
 // assume): replay says so. The ceiling camera sees it 1.125 times larger (its base tilts about the
 // floor, 2.7 m under the lamps, not about the camera, 2.4 m under them).
 TEST(Cli, ReplaySaysHowMuchTheFloorSwings) {
-  const auto dir =
-      std::filesystem::temp_directory_path() / ("lampnav_cli_swing_" + std::to_string(::getpid()));
-  const std::string log = (dir / "rough.mcap").string();
-  std::filesystem::create_directories(dir);
-  const Result sim = run("sim --scenario corridor --bumps 1.5 -q -o '" + log + "'");
-  ASSERT_EQ(sim.status, 0) << sim.err;
-  const Result r = run("replay '" + log + "' -q --out '" + (dir / "out").string() + "'");
-  EXPECT_EQ(r.status, 0) << r.err;
-  const std::string said = "the floor swings the ceiling camera by ";
-  const std::size_t at = r.err.find(said);
-  ASSERT_NE(at, std::string::npos) << r.err;
-  EXPECT_NEAR(std::stod(r.err.substr(at + said.size())), 1.5 * 1.125, 0.2) << r.err;
-  EXPECT_THAT(r.err.substr(at), HasSubstr("models assume 0.5"));
-  std::filesystem::remove_all(dir);
+  const Result r = replay_corridor("swing", "--bumps 1.5");
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NEAR(number_after(r.err, "the floor swings the ceiling camera by "), 1.5 * 1.125, 0.2)
+      << r.err;
+  EXPECT_THAT(r.err, HasSubstr("models assume 0.5"));
 }
 
 // The fixture: the museum seen from (8.0, -2.5) facing 34.4 degrees (0.6 rad), floor tilted by
