@@ -411,6 +411,11 @@ int main(int argc, char** argv) {
   for (const auto& [n, count] : {std::pair{"10", "20"}, {"100", "20"}, {"1000", "20"}})
     add_battery(std::string("unknown starts (") + count + "), " + n + "-node building",
                 std::string("BM_UnknownStartBattery/") + n + "/" + count, false);
+  add_battery(
+      "kidnaps (50), 100-node building, the floor swinging the cameras 1.5 deg (swing learnt)",
+      "BM_KidnapBatteryOnARoughFloor/100/50/1", true);
+  add_battery("  the same kidnaps, the lamps weighed for the configured 0.5 deg",
+              "BM_KidnapBatteryOnARoughFloor/100/50/0", true);
   add_battery("kidnaps (50), 100-node building of round lamps 4.5 m apart",
               "BM_RoundLampsFarApartBattery/100/50/1", true);
   add_battery("unknown starts (20), the same building", "BM_RoundLampsFarApartBattery/100/20/0",
