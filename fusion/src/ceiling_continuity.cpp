@@ -75,7 +75,6 @@ struct CeilingContinuity::Impl {
   std::size_t next_swing = 0;
   std::optional<double> learnt;
   double tilt;
-  bool steady = false;  // this frame's gates take the configured tilt_sigma
 
   Impl(const CameraDescription& camera, double lamp_height, const CeilingContinuityOptions& opt)
       : model(camera), geometry(camera), z(lamp_height), o(opt), tilt(opt.tilt_sigma) {
@@ -95,13 +94,15 @@ struct CeilingContinuity::Impl {
            px.y() <= model.height() - 1 - mv;
   }
 
-  bool comparable(const Sighting& from, Stamp to, const OdometryTrack& odometry) const {
+  bool comparable(const Sighting& from, Stamp to, const OdometryTrack& odometry,
+                  double max_travel) const {
     return from.stamp < to && from.stamp >= odometry.first_stamp() &&
-           odometry.travel(from.stamp, to) <= o.max_travel_m;
+           odometry.travel(from.stamp, to) <= max_travel;
   }
 
-  // `to`'s lamps against `from`'s, carried by the wheels.
-  Agreement compare(const Sighting& from, const Sighting& to, const OdometryTrack& odometry) const {
+  // `to`'s lamps against `from`'s, carried by the wheels, with the tilt spread `tilt_sigma`.
+  Agreement compare(const Sighting& from, const Sighting& to, const OdometryTrack& odometry,
+                    double tilt_sigma) const {
     Agreement a;
     const Pose2 moved = odometry.at(to.stamp).between(odometry.at(from.stamp));
     const Pose2 back = moved.inverse();
@@ -110,7 +111,7 @@ struct CeilingContinuity::Impl {
     for (const auto& p : from.lamps) carried.push_back(moved.transform_from(p));
     // Each frame has its own bump: the difference of two spreads.
     const auto gate = [&](double reach_a, double reach_b) {
-      const double spread = (steady ? o.tilt_sigma : tilt) * std::hypot(reach_a, reach_b);
+      const double spread = tilt_sigma * std::hypot(reach_a, reach_b);
       return o.gate_sigmas * std::hypot(spread, o.sigma_m) + travelled;
     };
     const auto near = [&](const Eigen::Vector2d& p, double reach,
@@ -138,21 +139,25 @@ struct CeilingContinuity::Impl {
   void learn_swing(const Sighting& from, const Sighting& to, const OdometryTrack& odometry) {
     const Pose2 moved = odometry.at(to.stamp).between(odometry.at(from.stamp));
     const Eigen::Matrix2d R = Eigen::Rotation2Dd(moved.yaw()).toRotationMatrix();
+    std::vector<Eigen::Vector2d> carried;
+    for (const auto& p : from.lamps) carried.push_back(moved.transform_from(p));
+    int added = 0;
     for (std::size_t k = 0; k < to.lamps.size(); ++k) {
       int near = 0;
       std::size_t match = 0;
-      for (std::size_t i = 0; i < from.lamps.size(); ++i)
-        if ((moved.transform_from(from.lamps[i]) - to.lamps[k]).norm() <= o.tilt_match_m) {
+      for (std::size_t i = 0; i < carried.size(); ++i)
+        if ((carried[i] - to.lamps[k]).norm() <= o.tilt_match_m) {
           ++near;
           match = i;
         }
       if (near != 1) continue;
-      const Eigen::Vector2d r = to.lamps[k] - moved.transform_from(from.lamps[match]);
+      const Eigen::Vector2d r = to.lamps[k] - carried[match];
       const Eigen::Matrix2d A = R * from.tilt_move[match];
       const Eigen::Matrix2d C = A * A.transpose() + to.tilt_move[k] * to.tilt_move[k].transpose();
       if (!(std::abs(C.determinant()) > 1e-12)) continue;
       const double d2 = r.dot(C.ldlt().solve(r));
       if (!std::isfinite(d2)) continue;
+      ++added;
       if (swing.size() < static_cast<std::size_t>(o.tilt_window)) {
         swing.push_back(d2);
       } else {
@@ -160,7 +165,8 @@ struct CeilingContinuity::Impl {
         next_swing = (next_swing + 1) % swing.size();
       }
     }
-    if (swing.size() < static_cast<std::size_t>(o.tilt_min_samples)) return;
+    // No new sample (a frame with no lamp matched alone): the spread is as it was.
+    if (added == 0 || swing.size() < static_cast<std::size_t>(o.tilt_min_samples)) return;
     std::vector<double> sorted = swing;
     auto mid = sorted.begin() + static_cast<std::ptrdiff_t>(sorted.size() / 2);
     std::nth_element(sorted.begin(), mid, sorted.end());
@@ -195,7 +201,6 @@ ContinuityVerdict CeilingContinuity::frame(Stamp stamp,
                                            const std::vector<vision::LampDetection>& lamps,
                                            const OdometryTrack& odometry, bool steady) {
   Impl& m = *impl_;
-  m.steady = steady;
   ContinuityVerdict v;
   Sighting now{stamp, {}, {}, {}};
   const double above = m.z - m.geometry.mount_origin().z();
@@ -211,8 +216,7 @@ ContinuityVerdict CeilingContinuity::frame(Stamp stamp,
   if (now.lamps.empty() || odometry.empty()) return v;
   if (m.anchor && stamp <= m.anchor->stamp) return v;  // out of order: neither compared nor kept
   if (m.o.learn_tilt) {
-    if (m.last && m.last->stamp < stamp && m.last->stamp >= odometry.first_stamp() &&
-        odometry.travel(m.last->stamp, stamp) <= m.o.tilt_pair_travel_m)
+    if (m.last && m.comparable(*m.last, stamp, odometry, m.o.tilt_pair_travel_m))
       m.learn_swing(*m.last, now, odometry);
     m.last = now;
   }
@@ -221,11 +225,13 @@ ContinuityVerdict CeilingContinuity::frame(Stamp stamp,
     m.anchor = std::move(s);
     m.odd.reset();
   };
-  if (!m.anchor || !m.comparable(*m.anchor, stamp, odometry)) {
+  if (!m.anchor || !m.comparable(*m.anchor, stamp, odometry, m.o.max_travel_m)) {
     anchor_on(now);
     return v;
   }
-  const Agreement a = m.compare(*m.anchor, now, odometry);
+  // While the robot is looked for (`steady`), the configured spread: see the header.
+  const double gate_tilt = steady ? m.o.tilt_sigma : m.tilt;
+  const Agreement a = m.compare(*m.anchor, now, odometry, gate_tilt);
   v.compared = true;
   v.since = m.anchor->stamp;
   v.matched = a.matched;
@@ -236,8 +242,8 @@ ContinuityVerdict CeilingContinuity::frame(Stamp stamp,
     return v;
   }
   v.odd = true;
-  if (m.odd && m.comparable(*m.odd, stamp, odometry) &&
-      m.compare(*m.odd, now, odometry).matched > 0) {
+  if (m.odd && m.comparable(*m.odd, stamp, odometry, m.o.max_travel_m) &&
+      m.compare(*m.odd, now, odometry, gate_tilt).matched > 0) {
     v.broken = true;
     v.moved_by = m.odd->stamp;
     char why[240];
