@@ -181,15 +181,9 @@ void kidnaps_on(int nodes, int episodes, int must_fix) {
 
 TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf10Nodes) { kidnaps_on(10, 10, 10); }
 // Nine of ten: episode 10 ends ambiguous between the truth and one look-alike (docs/hypotheses.md).
-// Not under the sanitizers: about 90 s here, more than ten minutes there, and the 100-node
-// battery runs the same code under them.
-TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf1000Nodes) {
-#if defined(__SANITIZE_ADDRESS__)
-  GTEST_SKIP() << "ten minutes under AddressSanitizer; the 100-node battery covers the same code";
-#else
-  kidnaps_on(1000, 10, 9);
-#endif
-}
+// Labelled long (tests/CMakeLists.txt): more than ten minutes under the sanitizers, where the
+// 10-node battery runs the same code.
+TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf1000Nodes) { kidnaps_on(1000, 10, 9); }
 TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf100Nodes) { kidnaps_on(100, 10, 10); }
 
 TEST(Hypotheses, UnknownStartsOnAGeneratedBuildingOf100Nodes) {
