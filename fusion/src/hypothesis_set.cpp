@@ -496,8 +496,21 @@ struct HypothesisSet::Impl {
              far + std::min(far, o.far_stray_cost_max);
     };
     double capped_best = capped(r.hypotheses.front());
+    std::size_t best = 0;
     for (std::size_t k = 1; k < n; ++k)
-      capped_best = std::min(capped_best, capped(r.hypotheses[k]));
+      if (const double c = capped(r.hypotheses[k]); c < capped_best) {
+        capped_best = c;
+        best = k;
+      }
+    // An image whose best place's lamps misfit past odd_image_misfit weighs its newborns as any
+    // frame does: the likeliest then leads the next by at most frame_cost_cap, short of
+    // publish_ratio, and it does not decide alone (the truth may not even be among them).
+    const auto& q = omni->options().pairs;
+    const PoseHypothesis& likeliest = r.hypotheses[best];
+    const bool odd = likeliest.score - q.miss_cost * likeliest.missing -
+                         q.spurious_cost * likeliest.unexplained >
+                     o.odd_image_misfit;
+    const double image_cap = odd ? o.frame_cost_cap : std::numeric_limits<double>::infinity();
     // What the drive said before this image: each hypothesis is born with the cost of the
     // carried place it continues (the least within the gate), so that the places the drive has
     // told apart from the truth are born behind it, not level with it.
@@ -508,7 +521,7 @@ struct HypothesisSet::Impl {
       return std::min(drive->least(p, prior.gate_m, prior.gate_rad), o.place_cost_max);
     };
     const auto cost_of = [&](const PoseHypothesis& h) {
-      return capped(h) - capped_best + drive_cost(h.pose);
+      return std::min(image_cap, capped(h) - capped_best) + drive_cost(h.pose);
     };
     // A place of the drive this image did not allow still counts while its cost stays within
     // place_cost_max (one odd image, a lamp hidden, never removes the truth): it is born too,
@@ -543,7 +556,7 @@ struct HypothesisSet::Impl {
       places.clear();
       last_enumeration.reset();
       omni_frames = 1;  // this image weighed them
-      decided_by_one_image = !r_with_prior && !beyond_map(r.hypotheses.front());
+      decided_by_one_image = !r_with_prior && !beyond_map(r.hypotheses.front()) && !odd;
       last_why.clear();
       return;
     }

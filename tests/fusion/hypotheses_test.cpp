@@ -5,6 +5,7 @@
 // wrong; "it is one of these" is always allowed.
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <initializer_list>
 #include <iostream>
@@ -177,6 +178,29 @@ void kidnaps_on(int nodes, int episodes, int must_fix) {
     EXPECT_GE(fixed, must_fix);
   }
   std::cout << w.b.nodes << " nodes, " << w.b.lamps << " lamps: " << test::summarize(rs) << "\n";
+}
+
+// Each bad option refused by its name (InputError), the set not built.
+TEST(Hypotheses, BadOptionsAreRefusedByName) {
+  const Building w(test::asymmetric_building(10));
+  const auto refused = [&](const HypothesisSetOptions& o) -> std::string {
+    try {
+      const HypothesisSet set(w.map, nullptr, nullptr, CeilingPipelineOptions{}, o);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  HypothesisSetOptions o;
+  EXPECT_EQ(refused(o), "");
+  o.odd_image_misfit = std::nan("");
+  EXPECT_THAT(refused(o), testing::HasSubstr("odd_image_misfit"));
+  o = {};
+  o.frame_cost_cap = -1;
+  EXPECT_THAT(refused(o), testing::HasSubstr("frame_cost_cap"));
+  o = {};
+  o.publish_posterior = 1.5;
+  EXPECT_THAT(refused(o), testing::HasSubstr("publish_posterior"));
 }
 
 TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf10Nodes) { kidnaps_on(10, 10, 10); }
