@@ -93,7 +93,7 @@ struct HypothesisSetOptions {
   // behind the likeliest, and it does not decide alone: the truth may not be among them.
   // Born from such an image (misfit 52) after a false alarm on a floor swinging the cameras 1.5
   // degrees, a twin corridor 28 m off led the truth by 39 and was published for 22.7 s. No image
-  // of the default floor's office drives passed 4.4, nor of the museum's kidnaps 4.2, nor of the
+  // of the default floor's office drives passed 4.4, nor of the museum's kidnaps 4.1, nor of the
   // grid office's and the 4 m ceiling's tests 12.1 (docs/hypotheses.md, "An image that fits no
   // place").
   double odd_image_misfit = 20.0;
