@@ -82,7 +82,8 @@ Metrics score(const ReplayResult& r, const io::MissionLog& log) {
         {kidnaps[k], fix != fixes.end() ? std::optional<Stamp>((*fix)->stamp) : std::nullopt});
   }
   m.relocalization_latency_s = stats_of(latency);
-  // Errors: tracking estimates outside [kidnap, its fix).
+  // Errors: tracking estimates outside [kidnap, its fix] (one at the fix's instant was published
+  // before the frame that made the fix was taken in: a loss and a fix from one omni frame).
   m.has_truth = !log.truth.empty();
   for (int s = 0; s < 3; ++s) m.input_faults[s] = r.outcome.faults[s];
   if (!m.has_truth) return m;
@@ -92,7 +93,7 @@ Metrics score(const ReplayResult& r, const io::MissionLog& log) {
     if (e.mode != fusion::LocalizerMode::tracking) continue;
     bool skip = false;
     for (const auto& [from, to] : unsure)
-      if (e.stamp >= from && (!to || e.stamp < *to)) skip = true;
+      if (e.stamp >= from && (!to || e.stamp <= *to)) skip = true;
     if (skip) continue;
     const Pose2 t = truth.at(e.stamp);
     pos.push_back((e.pose.translation() - t.translation()).norm());

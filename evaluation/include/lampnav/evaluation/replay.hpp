@@ -117,7 +117,7 @@ ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
 // The metrics of a run against its log (spec/cli.md), from what the run published: frames and
 // lamps counted, time lost and time ambiguous (each estimate's mode held until the next one),
 // kidnaps (the log's events) and the first `relocalized` after each, errors of the poses published
-// as tracking outside [kidnap, its fix), and wrong fixes: stretches of poses published as certain
+// as tracking outside [kidnap, its fix], and wrong fixes: stretches of poses published as certain
 // more than 0.5 m from the truth, except from a kidnap to the localizer's first mode change after
 // it (10 s at most). Runtime, real-time factor and frames too old are left to the caller.
 Metrics score(const ReplayResult& run, const io::MissionLog& log);
