@@ -29,6 +29,11 @@ void LocalizerOptions::validate() const {
   if (!(second_opinion_distance > 0 && std::isfinite(second_opinion_distance)))
     throw InputError({"", "localizer options", "second_opinion_distance"},
                      "must be a positive distance in m");
+  if (audit_period < Duration::zero())
+    throw InputError({"", "localizer options", "audit_period"}, "must not be negative");
+  if (!(audit_ratio >= 1 && std::isfinite(audit_ratio)))
+    throw InputError({"", "localizer options", "audit_ratio"},
+                     "must be a likelihood ratio of at least 1");
   if (!(max_odometry_gap > Duration::zero()))
     throw InputError({"", "localizer options", "max_odometry_gap"}, "must be positive");
   hypotheses.validate();
@@ -70,6 +75,15 @@ struct Localizer::Impl {
   vision::OmniDetection last_omni;
   Stamp last_omni_stamp;
   std::optional<Stamp> last_omni_check;
+  std::optional<Stamp> last_audit;
+  // An omni frame to audit (its capture time, the estimate then and its check), left for
+  // Localizer::audit() or the next input; last_omni is still that frame's.
+  struct PendingAudit {
+    Stamp stamp;
+    FilterState prior;
+    OmniCheckResult check;
+  };
+  std::optional<PendingAudit> pending_audit;
   std::vector<LocalizerEvent> events;
   Stamp evidence;  // capture time of the input being taken in (LocalizerEvent::evidence)
   LocalizerCounts counts;
@@ -119,6 +133,7 @@ struct Localizer::Impl {
     mode = m;
     events.push_back({now(), m, cause, why, evidence});
     if (unsure() && !was_unsure) {
+      last_audit.reset();               // audits start again with the next certain stretch
       if (pipeline) pipeline->reset();  // its labels are worthless
       calibration.forget_measurements();
     }
@@ -207,8 +222,11 @@ struct Localizer::Impl {
   // An omni check disagreed with the estimate once: does the frame itself put the robot
   // elsewhere, far more likely than where the estimate is? Both poses are scored alike (the
   // estimate's uncertainty for both), so the ratio compares the places, not their refinement.
-  std::optional<LossVerdict> second_opinion(const FilterState& prior, const OmniCheckResult& r) {
-    if (o.second_opinion_ratio <= 0) return std::nullopt;
+  // `audit`: asked on schedule (audit_period), not because the check disagreed.
+  std::optional<LossVerdict> second_opinion(const FilterState& prior, const OmniCheckResult& r,
+                                            bool audit = false) {
+    const double ratio = audit ? o.audit_ratio : o.second_opinion_ratio;
+    if (ratio <= 0) return std::nullopt;
     const GlobalLocalization g = global->locate(last_omni);
     if (!g.found() || g.ambiguous) return std::nullopt;
     const Pose2& alt = g.hypotheses.front().pose;
@@ -219,14 +237,50 @@ struct Localizer::Impl {
     const double here = global->score(prior.pose(), sp, sy, last_omni).cost;
     const double there = global->score(alt, sp, sy, last_omni).cost;
     const double log_ratio = 0.5 * (here - there);
-    if (log_ratio < std::log(o.second_opinion_ratio)) return std::nullopt;
+    if (log_ratio < std::log(ratio)) return std::nullopt;
     ++counts.second_opinions;
-    char why[200];
-    std::snprintf(why, sizeof why,
-                  "the omnidirectional view does not match the estimate (%d of %d predicted lamps "
-                  "seen) and puts the robot %.1f m away, e^%.0f times likelier",
-                  r.matched, r.expected, away, log_ratio);
+    char why[240];
+    if (audit) {
+      ++counts.audit_losses;
+      std::snprintf(why, sizeof why,
+                    "an audit of the omnidirectional view puts the robot %.1f m away, e^%.0f "
+                    "times likelier than the estimate, whose near lamps it matches (%d of %d): "
+                    "a look-alike place",
+                    away, log_ratio, r.matched, r.expected);
+    } else {
+      std::snprintf(why, sizeof why,
+                    "the omnidirectional view does not match the estimate (%d of %d predicted "
+                    "lamps seen) and puts the robot %.1f m away, e^%.0f times likelier",
+                    r.matched, r.expected, away, log_ratio);
+    }
     return LossVerdict{ModeCause::omni_locates_elsewhere, why};
+  }
+
+  // Whether an omni frame is audited: on schedule while the estimate is certain (the first
+  // frame of a certain stretch starts the schedule, so a fix is not audited by its own image).
+  bool audit_due(Stamp stamp) {
+    if (o.audit_period <= Duration::zero() || unsure()) return false;
+    if (last_audit && stamp > *last_audit && stamp - *last_audit < o.audit_period) return false;
+    const bool first = !last_audit || stamp < *last_audit;
+    last_audit = stamp;
+    return !first;
+  }
+
+  // The pending audit, if the estimate is still certain: a loss it proves is declared on its
+  // frame's evidence, and that frame is the first the hypotheses weigh.
+  bool run_audit() {
+    if (!pending_audit) return false;
+    const PendingAudit a = std::move(*pending_audit);
+    pending_audit.reset();
+    if (unsure()) return false;
+    ++counts.audits;
+    evidence = a.stamp;
+    const std::optional<LossVerdict> loss = second_opinion(a.prior, a.check, true);
+    if (!loss) return true;
+    monitor.reset();
+    lose(loss);
+    if (unsure()) relocalize(a.stamp);
+    return true;
   }
 
   // While tracking: the omni frame's lamps, matched near the estimate, as a pose measurement.
@@ -443,6 +497,7 @@ Localizer::Localizer(Localizer&&) noexcept = default;
 
 void Localizer::initialize(Stamp stamp, const Pose2& pose, const Eigen::Matrix3d& P) {
   Impl& m = *impl_;
+  m.pending_audit.reset();  // told where the robot is
   m.ekf.initialize(stamp, pose, P);
   m.monitor.reset();
   if (m.pipeline) m.pipeline->reset();
@@ -457,6 +512,7 @@ bool Localizer::initialized() const { return impl_->ekf.initialized(); }
 
 std::optional<Refusal> Localizer::wheels(Stamp stamp, double left, double right) {
   Impl& m = *impl_;
+  m.run_audit();
   m.evidence = stamp;
   ++m.counts.wheel_readings;
   // The first reading is the baseline (no motion); NaN or inf is refused by the filter.
@@ -487,15 +543,18 @@ std::optional<FilterState> Localizer::prior_at(Stamp stamp) const {
 }
 
 const CeilingObservation& Localizer::ceiling_frame(Stamp stamp, const vision::ImageView& image) {
+  impl_->run_audit();
   return impl_->ceiling(stamp, image, *this);
 }
 
 const CeilingObservation& Localizer::ceiling_detections(
     Stamp stamp, const std::vector<vision::LampDetection>& lamps) {
+  impl_->run_audit();
   return impl_->ceiling(stamp, lamps, *this);
 }
 
 void Localizer::ceiling_observation(const CeilingObservation& ob) {
+  impl_->run_audit();
   impl_->evidence = ob.stamp;
   if (impl_->unsure()) {
     ++impl_->counts.frames_while_lost;  // labelled from a pose that is not known
@@ -520,6 +579,7 @@ const vision::OmniDetection& Localizer::omni_frame(Stamp stamp, const vision::Im
 void Localizer::omni_detection(Stamp stamp, const vision::OmniDetection& detection) {
   Impl& m = *impl_;
   if (!m.global) throw InputError({"", "robot.json", "cameras"}, "the robot has no omni_camera");
+  m.run_audit();  // on the frame before this one
   m.last_omni = detection;
   m.last_omni_stamp = stamp;
   m.evidence = stamp;
@@ -544,16 +604,22 @@ void Localizer::omni_detection(Stamp stamp, const vision::OmniDetection& detecti
   m.lose(loss);
   if (m.unsure()) {
     m.relocalize(stamp);  // the frame that showed the loss shows where the robot is
-  } else if (m.o.omni_update_min_lamps > 0 &&
-             (r.conclusive ? r.consistent : m.o.omni_update_unchecked)) {
-    m.omni_update(stamp, *prior, r.conclusive);
+    return;
   }
+  // (A frame the check found inconsistent was asked the same already: second_opinion.)
+  if (m.audit_due(stamp) && !(r.conclusive && !r.consistent))
+    m.pending_audit = Impl::PendingAudit{stamp, *prior, r};
+  if (m.o.omni_update_min_lamps > 0 && (r.conclusive ? r.consistent : m.o.omni_update_unchecked))
+    m.omni_update(stamp, *prior, r.conclusive);
 }
 
 bool Localizer::global_fix(const GlobalFix& fix) {
+  impl_->pending_audit.reset();  // told where the robot is
   impl_->evidence = fix.stamp;
   return impl_->apply_fix(fix);
 }
+
+bool Localizer::audit() { return impl_->run_audit(); }
 
 LocalizerEstimate Localizer::estimate() const {
   const Impl& m = *impl_;

@@ -100,6 +100,7 @@ RunOutcome Runtime::run(Robot& robot, const std::optional<Pose2>& start,
         if (!localizer_.has_omni_camera()) continue;
         ++out.omni_frames;
         obs.on_omni(f, localizer_.omni_frame(f.capture, view));
+        localizer_.audit();  // once the frame's pose is out
       }
     } catch (const InputError& e) {
       ++out.refused_frames;

@@ -536,6 +536,57 @@ TEST(Localizer, DomusKidnapEveryJumpDetected) {
   EXPECT_EQ(r.false_alarms, 0);
 }
 
+// Audits (LocalizerOptions::audit_period): one omni frame in 5 s while the estimate is certain,
+// the first of a certain stretch only starting the schedule. The search waits for audit(), so that
+// the frame's pose goes out first, or for the next input.
+TEST(Localizer, AuditsRunOnScheduleOnceThePoseIsOut) {
+  const World w("maps/office_floor.geojson");
+  // Omni frames at 1, 2, ..., 12 s with nothing in them, audit() called after each but the 11th;
+  // what audit() said and how many audits ran by then.
+  const auto drive = [&](LocalizerOptions o) {
+    o.omni_check_period = std::chrono::milliseconds(500);  // every frame checked
+    Localizer loc(w.map, w.robot, o);
+    loc.initialize(stamp_from_seconds(0), Pose2(1, 10, 0), Vector3d(1e-4, 1e-4, 1e-4).asDiagonal());
+    std::vector<bool> ran;
+    std::vector<std::uint64_t> audits;
+    for (int k = 0; k <= 1200; ++k) {
+      const double t = 0.01 * k;
+      loc.wheels(stamp_from_seconds(t), 0.005 * k, 0.005 * k);
+      if (k == 0 || k % 100 != 0) continue;
+      loc.omni_detection(stamp_from_seconds(t - 0.005), vision::OmniDetection{});
+      if (k == 1100) continue;  // left to the next wheel reading
+      ran.push_back(loc.audit());
+      audits.push_back(loc.counts().audits);
+    }
+    EXPECT_EQ(loc.counts().audit_losses, 0u);  // an empty frame puts the robot nowhere else
+    EXPECT_EQ(loc.mode(), LocalizerMode::tracking);
+    return std::pair{ran, audits};
+  };
+  // The frame at 1 s starts the schedule; those at 6 s and 11 s are audited, the second by the
+  // wheel reading after it.
+  const auto [ran, audits] = drive({});
+  EXPECT_EQ(ran, (std::vector<bool>{0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0}));
+  EXPECT_EQ(audits, (std::vector<std::uint64_t>{0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 2}));
+  LocalizerOptions off;
+  off.audit_period = Duration::zero();
+  EXPECT_EQ(drive(off).second, std::vector<std::uint64_t>(11, 0));
+  off.audit_period = -std::chrono::seconds(1);
+  try {
+    const Localizer bad(w.map, w.robot, off);
+    ADD_FAILURE() << "a negative audit period was taken";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), testing::HasSubstr("audit_period"));
+  }
+  off = {};
+  off.audit_ratio = 0.5;
+  try {
+    const Localizer bad(w.map, w.robot, off);
+    ADD_FAILURE() << "an audit ratio below 1 was taken";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), testing::HasSubstr("audit_ratio"));
+  }
+}
+
 }  // namespace
 }  // namespace lampnav::fusion
 

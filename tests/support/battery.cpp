@@ -191,6 +191,7 @@ struct Battery::Impl {
           loc.ceiling_detections(stamp(p.capture), p.lamps);
         else
           loc.omni_detection(stamp(p.capture), p.omni);
+        loc.audit();  // as the node does, once the frame's pose is out
         const double took =
             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         r.localizer_s += took;

@@ -74,6 +74,18 @@ struct LocalizerOptions {
   // and the robot is looked for at once (the estimate stays one of the places it may be). 0 off.
   double second_opinion_ratio = 1000;
   double second_opinion_distance = 1.0;  // m
+  // The same question asked of an omni frame at least this long after the last one asked, while
+  // the estimate is certain, whatever the omni check said. A robot put down in a look-alike spot
+  // (a corridor of the same lamps, at the same phase between two of them, turned so that the
+  // lamps it had in view fit again) passes every local check: the ceiling camera sees the lamp
+  // where the wheels put it and the omni check's near lamps are where the estimate predicts
+  // them; only the lamps further off, which the whole frame's search weighs, tell the twin
+  // apart. Each audit costs one global search (docs/localization.md, "Audits"). 0 off.
+  Duration audit_period = std::chrono::seconds(5);
+  // The likelihood ratio an audit needs, far above the second opinion's: nothing local doubts
+  // the estimate then. Measured: places likelier than a right estimate by at most e^10.4 (a map
+  // of part of the building), than a wrong one by e^57.5 to e^79.4. e^30 is about 1e13.
+  double audit_ratio = 1e13;
   // Wheel readings further apart than this (odometry that stopped and came back, a clock that
   // jumped) leave the motion in between unknown: the estimate is no longer certain, and the
   // localizer looks for the robot again (keeping the estimate as one of the places it may be).
@@ -132,6 +144,8 @@ struct LocalizerCounts {
   std::uint64_t omni_updates = 0;           // omni pose measurements applied while tracking
   std::uint64_t odometry_gaps = 0;          // wheel readings further apart than max_odometry_gap
   std::uint64_t second_opinions = 0;  // losses an omni frame proved by locating the robot elsewhere
+  std::uint64_t audits = 0;           // omni frames asked where the robot is while tracking
+  std::uint64_t audit_losses = 0;     // of those, the losses an audit proved (in second_opinions)
   std::uint64_t unseen_moves = 0;     // ceiling frames that saw a move the wheels did not
   std::uint64_t frames_before_move = 0;  // captured before such a move: weighed no hypothesis
 };
@@ -171,6 +185,10 @@ class Localizer {
   const vision::OmniDetection& omni_frame(Stamp stamp, const vision::ImageView& image);
   // The same with the frame's detections (from an outside detector, or a test).
   void omni_detection(Stamp stamp, const vision::OmniDetection& detection);
+  // The audit an omni frame left due (LocalizerOptions::audit_period): one global search, work
+  // that can wait until the frame's pose is out. Every other input runs it first, so a caller
+  // that never calls this still has its frames audited, one input later. True when one ran.
+  bool audit();
   // A relocalized pose: re-initializes state and covariance at its capture time and re-applies
   // the odometry since. False (and counted) when it is older than the history or not finite.
   bool global_fix(const GlobalFix& fix);
