@@ -241,7 +241,6 @@ struct Localizer::Impl {
     ++counts.second_opinions;
     char why[240];
     if (audit) {
-      ++counts.audit_losses;
       std::snprintf(why, sizeof why,
                     "an audit of the omnidirectional view puts the robot %.1f m away, e^%.0f "
                     "times likelier than the estimate, whose near lamps it matches (%d of %d): "
@@ -260,10 +259,10 @@ struct Localizer::Impl {
   // frame of a certain stretch starts the schedule, so a fix is not audited by its own image).
   bool audit_due(Stamp stamp) {
     if (o.audit_period <= Duration::zero() || unsure()) return false;
-    if (last_audit && stamp > *last_audit && stamp - *last_audit < o.audit_period) return false;
-    const bool first = !last_audit || stamp < *last_audit;
+    const bool started = last_audit && stamp >= *last_audit;  // else a new schedule
+    if (started && stamp - *last_audit < o.audit_period) return false;
     last_audit = stamp;
-    return !first;
+    return started;
   }
 
   // The pending audit, if the estimate is still certain: a loss it proves is declared on its
@@ -277,6 +276,7 @@ struct Localizer::Impl {
     evidence = a.stamp;
     const std::optional<LossVerdict> loss = second_opinion(a.prior, a.check, true);
     if (!loss) return true;
+    ++counts.audit_losses;
     monitor.reset();
     lose(loss);
     if (unsure()) relocalize(a.stamp);
