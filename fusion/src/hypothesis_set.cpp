@@ -3,6 +3,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <map>
 #include <optional>
@@ -19,6 +20,13 @@
 #include "pose_grid.hpp"
 
 namespace lampnav::fusion {
+namespace detail {
+std::string one_decimal(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.1f", v);
+  return b;
+}
+}  // namespace detail
 
 namespace {
 constexpr double kDeg = M_PI / 180.0;
@@ -46,6 +54,11 @@ struct HypothesisSet::Impl {
   // explains all it shows: its set may publish from it (min_omni_frames does not apply).
   bool decided_by_one_image = false;
   int omni_frames = 0;  // omni frames that weighed the set since it became complete
+  // The image that completed the set showed lamps beyond the map's places: the set publishes only
+  // after partial_view_travel_m of travel since `completed_at`.
+  bool view_beyond_map = false;
+  Stamp completed_at;
+  double travel_since_complete = 0;  // m, to the last frame that weighed the set
   int next_id = 1;
   std::string last_why = "no omni image yet";
   Counts counts;
@@ -556,7 +569,10 @@ struct HypothesisSet::Impl {
       places.clear();
       last_enumeration.reset();
       omni_frames = 1;  // this image weighed them
-      decided_by_one_image = !r_with_prior && !beyond_map(r.hypotheses.front()) && !odd;
+      view_beyond_map = beyond_map(r.hypotheses.front());
+      decided_by_one_image = !r_with_prior && !view_beyond_map && !odd;
+      completed_at = stamp;
+      travel_since_complete = 0;
       last_why.clear();
       return;
     }
@@ -575,6 +591,14 @@ struct HypothesisSet::Impl {
   }
 
   int frames_to_publish() const { return decided_by_one_image ? 1 : o.min_omni_frames; }
+  // Metres the robot must still travel before the set may publish.
+  double travel_to_publish() const {
+    return view_beyond_map ? std::max(0.0, o.partial_view_travel_m - travel_since_complete) : 0.0;
+  }
+  void note_travel(Stamp stamp, const OdometryTrack& odo) {
+    if (complete && stamp > completed_at)
+      travel_since_complete = std::max(travel_since_complete, odo.travel(completed_at, stamp));
+  }
 
   void reset(const std::string& why) {
     ++counts.resets;
@@ -583,6 +607,7 @@ struct HypothesisSet::Impl {
     hs.clear();
     complete = false;
     omni_frames = 0;
+    view_beyond_map = false;
     last_why = why;
   }
 };
@@ -600,6 +625,7 @@ void HypothesisSet::clear(const std::string& why) {
   m.hs.clear();
   m.complete = false;
   m.omni_frames = 0;
+  m.view_beyond_map = false;
   m.twin_cache.clear();
   m.last_enumeration.reset();
   m.places.clear();
@@ -643,6 +669,7 @@ void HypothesisSet::omni(Stamp stamp, const vision::OmniDetection& d,
         m.weigh_all(stamp, odometry, m.o.frame_cost_cap, m.o.omni_tie_cost,
                     [&](Hypothesis& h) { return m.weigh_omni(h, d); });
     if (m.complete) ++m.omni_frames;
+    m.note_travel(stamp, odometry);
     m.tidy();
     // Every hypothesis contradicted: the robot is none of them (carried away again, or the set
     // lost it). Starting again costs what was learnt, never the pose.
@@ -663,6 +690,7 @@ void HypothesisSet::ceiling(Stamp stamp, const std::vector<vision::LampDetection
   if (!m.labeller || m.hs.empty() || !m.complete) return;
   m.weigh_all(stamp, odometry, m.o.ceiling_cost_cap, 0.0,
               [&](Hypothesis& h) { return m.weigh_ceiling(h, lamps); });
+  m.note_travel(stamp, odometry);
   m.tidy();
   if (m.complete && m.hs.empty()) m.reset("every hypothesis went through a wall");
 }
@@ -672,7 +700,9 @@ bool HypothesisSet::complete() const { return impl_->complete; }
 
 const Hypothesis* HypothesisSet::winner() const {
   const Impl& m = *impl_;
-  if (!m.complete || m.hs.empty() || m.omni_frames < m.frames_to_publish()) return nullptr;
+  if (!m.complete || m.hs.empty() || m.omni_frames < m.frames_to_publish() ||
+      m.travel_to_publish() > 0)
+    return nullptr;
   const Hypothesis& best = m.hs.front();
   if (best.weight < m.o.publish_posterior || best.contradicted) return nullptr;
   if (m.hs.size() > 1 && m.hs[0].log_weight - m.hs[1].log_weight < std::log(m.o.publish_ratio))
@@ -702,6 +732,10 @@ std::string HypothesisSet::why() const {
         << (m.hs.front().node ? " in " + m.hs.front().node->name : std::string()) << ")";
       if (const int more = m.frames_to_publish() - m.omni_frames; more > 0)
         s << ", waiting for " << more << " more omni frame" << (more > 1 ? "s" : "");
+      if (const double more = m.travel_to_publish(); more > 0)
+        s << ", waiting for " << detail::one_decimal(more)
+          << " m more of travel: the view shows lamps beyond the map's places, so the robot may "
+             "be where the map has nothing";
       return s.str();
     case HypothesisVerdict::symmetric:
       s << "the building looks the same from " << m.hs.size() << " places (";

@@ -32,6 +32,8 @@ void HypothesisSetOptions::validate() const {
         "must be between 0.5 and 1");
   check(publish_ratio >= 1, "publish_ratio", "must be at least 1");
   check(min_omni_frames >= 1, "min_omni_frames", "must be at least 1");
+  check(partial_view_travel_m >= 0 && std::isfinite(partial_view_travel_m), "partial_view_travel_m",
+        "must be a finite distance, at least 0");
   check(max_hypotheses >= 1 && max_hypotheses <= 100000, "max_hypotheses", "must be 1 to 100000");
   check(place_gate_m > 0 && place_gate_deg > 0, "place_gate_m", "must be positive");
   check(place_cost_max >= frame_cost_cap, "place_cost_max", "must be at least frame_cost_cap");

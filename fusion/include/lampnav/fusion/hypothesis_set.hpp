@@ -47,6 +47,14 @@ struct HypothesisSetOptions {
   // built from one drive, without their start; 2 at 3 (docs/hypotheses.md, "Three images before
   // a set publishes").
   int min_omni_frames = 3;
+  // And when the image that completed the set shows lamps beyond the map's places (a map of part
+  // of a building: the robot may be where the map has nothing, and a corridor there looks like a
+  // corridor of the map), the robot must also have travelled this far (m) since: a set of places
+  // the robot is not at is then carried through the map's walls or contradicted by what the drive
+  // shows next. Carried off a map built from one drive, robots in the office's corridors the map
+  // lacks were published on its look-alike corridor: 17 wrong fixes on 25 drives without their
+  // start, 14 on 24 with it (docs/hypotheses.md, "Carried off a map of part of a building").
+  double partial_view_travel_m = 8.0;
   int max_hypotheses = 512;    // an image fitting more places leaves the set incomplete
   int symmetry_check_max = 8;  // at most this many hypotheses are checked for twins
   // While the set is incomplete, the next enumeration waits for this much travel (m) or turn
