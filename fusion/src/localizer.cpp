@@ -34,6 +34,11 @@ void LocalizerOptions::validate() const {
   if (!(audit_ratio >= 1 && std::isfinite(audit_ratio)))
     throw InputError({"", "localizer options", "audit_ratio"},
                      "must be a likelihood ratio of at least 1");
+  if (audit_challenge_frames < 1)
+    throw InputError({"", "localizer options", "audit_challenge_frames"}, "must be at least 1");
+  if (!(audit_step_ratio >= 1 && audit_step_ratio <= audit_ratio))
+    throw InputError({"", "localizer options", "audit_step_ratio"},
+                     "must be a likelihood ratio of at least 1, at most audit_ratio");
   if (!(max_odometry_gap > Duration::zero()))
     throw InputError({"", "localizer options", "max_odometry_gap"}, "must be positive");
   hypotheses.validate();
@@ -84,6 +89,19 @@ struct Localizer::Impl {
     OmniCheckResult check;
   };
   std::optional<PendingAudit> pending_audit;
+  // A place an audit found likelier than the estimate by audit_step_ratio or more, short of
+  // audit_ratio: carried by the wheels and weighed against the estimate in each omni frame that
+  // follows, the evidence added up (LocalizerOptions::audit_step_ratio).
+  struct Challenger {
+    Pose2 pose;      // at `stamp`
+    Pose2 odometry;  // the dead-reckoned pose at `stamp`
+    Stamp stamp;
+    Pose2 counted_odometry;  // where the robot was at the last image counted
+    double log_sum = 0;      // ln of the likelihood ratios counted, added up
+    int images = 0;          // images counted
+    int frames = 0;          // frames weighed
+  };
+  std::optional<Challenger> challenger;
   std::vector<LocalizerEvent> events;
   Stamp evidence;  // capture time of the input being taken in (LocalizerEvent::evidence)
   LocalizerCounts counts;
@@ -133,7 +151,8 @@ struct Localizer::Impl {
     mode = m;
     events.push_back({now(), m, cause, why, evidence});
     if (unsure() && !was_unsure) {
-      last_audit.reset();               // audits start again with the next certain stretch
+      last_audit.reset();  // audits start again with the next certain stretch
+      challenger.reset();
       if (pipeline) pipeline->reset();  // its labels are worthless
       calibration.forget_measurements();
     }
@@ -219,39 +238,120 @@ struct Localizer::Impl {
     settle(stamp);
   }
 
-  // An omni check disagreed with the estimate once: does the frame itself put the robot
-  // elsewhere, far more likely than where the estimate is? Both poses are scored alike (the
-  // estimate's uncertainty for both), so the ratio compares the places, not their refinement.
-  // `audit`: asked on schedule (audit_period), not because the check disagreed.
-  std::optional<LossVerdict> second_opinion(const FilterState& prior, const OmniCheckResult& r,
-                                            bool audit = false) {
-    const double ratio = audit ? o.audit_ratio : o.second_opinion_ratio;
-    if (ratio <= 0) return std::nullopt;
+  // The likeliest place an omni frame's search finds more than second_opinion_distance from the
+  // estimate, and ln of how much likelier than the estimate it is. Both poses are scored alike
+  // (the estimate's uncertainty for both), so the ratio compares the places, not their
+  // refinement. `named`: only a search that names one place (not ambiguous) answers, and only
+  // with that place.
+  struct Elsewhere {
+    Pose2 pose;
+    double away = 0;       // m
+    double log_ratio = 0;  // ln L(there) - ln L(estimate)
+  };
+  std::optional<Elsewhere> elsewhere(const FilterState& prior, bool named) {
     const GlobalLocalization g = global->locate(last_omni);
-    if (!g.found() || g.ambiguous) return std::nullopt;
-    const Pose2& alt = g.hypotheses.front().pose;
-    const double away = (alt.translation() - prior.pose().translation()).norm();
-    if (away < o.second_opinion_distance) return std::nullopt;
+    if (!g.found() || (named && g.ambiguous)) return std::nullopt;
+    const auto far =
+        std::find_if(g.hypotheses.begin(), named ? g.hypotheses.begin() + 1 : g.hypotheses.end(),
+                     [&](const PoseHypothesis& h) {
+                       return (h.pose.translation() - prior.pose().translation()).norm() >=
+                              o.second_opinion_distance;
+                     });
+    if (far == (named ? g.hypotheses.begin() + 1 : g.hypotheses.end())) return std::nullopt;
+    return compared(prior, far->pose);
+  }
+  // A place weighed against the estimate on the last omni frame.
+  Elsewhere compared(const FilterState& prior, const Pose2& there_pose) const {
     const double sp = std::clamp(std::sqrt(std::max(prior.P(0, 0), prior.P(1, 1))), 0.05, 0.5);
     const double sy = std::clamp(std::sqrt(prior.P(2, 2)), 0.5 * kDeg, 5 * kDeg);
     const double here = global->score(prior.pose(), sp, sy, last_omni).cost;
-    const double there = global->score(alt, sp, sy, last_omni).cost;
-    const double log_ratio = 0.5 * (here - there);
-    if (log_ratio < std::log(ratio)) return std::nullopt;
+    const double there = global->score(there_pose, sp, sy, last_omni).cost;
+    return Elsewhere{there_pose, (there_pose.translation() - prior.pose().translation()).norm(),
+                     0.5 * (here - there)};
+  }
+
+  // An omni check disagreed with the estimate once: does the frame itself put the robot
+  // elsewhere, far more likely than where the estimate is?
+  std::optional<LossVerdict> second_opinion(const FilterState& prior, const OmniCheckResult& r) {
+    if (o.second_opinion_ratio <= 0) return std::nullopt;
+    const std::optional<Elsewhere> e = elsewhere(prior, true);
+    if (!e || e->log_ratio < std::log(o.second_opinion_ratio)) return std::nullopt;
     ++counts.second_opinions;
     char why[240];
-    if (audit) {
+    std::snprintf(why, sizeof why,
+                  "the omnidirectional view does not match the estimate (%d of %d predicted "
+                  "lamps seen) and puts the robot %.1f m away, e^%.0f times likelier",
+                  r.matched, r.expected, e->away, e->log_ratio);
+    return LossVerdict{ModeCause::omni_locates_elsewhere, why};
+  }
+
+  // An audit: the frame's search asked whether some place away from the estimate is likelier.
+  // One likelier by audit_ratio proves a loss; one likelier by audit_step_ratio becomes the
+  // challenger, which the frames that follow weigh (challenge()).
+  std::optional<LossVerdict> audit_verdict(Stamp stamp, const FilterState& prior,
+                                           const OmniCheckResult& r) {
+    if (challenger) return challenge(stamp, prior, r);
+    const std::optional<Elsewhere> e = elsewhere(prior, false);
+    if (!e || e->log_ratio < std::log(o.audit_step_ratio)) return std::nullopt;
+    if (e->log_ratio >= std::log(o.audit_ratio)) return audit_loss(*e, e->log_ratio, 1, r);
+    if (odometry.empty()) return std::nullopt;
+    const Pose2 at = odometry.at(stamp);
+    challenger = Challenger{e->pose, at, stamp, at, e->log_ratio, 1, 1};
+    return std::nullopt;
+  }
+
+  // The challenger carried to this frame by the wheels, refined on it, and weighed against the
+  // estimate: a frame where it is the less likely clears it; the images taken at least
+  // HypothesisSetOptions::station_m apart add up (one spot's images repeat one image's
+  // evidence), up to audit_ratio: a loss. Cleared after audit_challenge_frames frames short of
+  // it.
+  std::optional<LossVerdict> challenge(Stamp stamp, const FilterState& prior,
+                                       const OmniCheckResult& r) {
+    Challenger& c = *challenger;
+    const Pose2 now = odometry.at(stamp);
+    Pose2 there = c.pose * c.odometry.between(now);
+    if (const std::optional<PoseHypothesis> refined =
+            global->refine(there, 0.3, 3 * kDeg, last_omni))
+      there = refined->pose;
+    const Elsewhere e = compared(prior, there);
+    c.pose = there;
+    c.odometry = now;
+    c.stamp = stamp;
+    ++c.frames;
+    if (e.log_ratio < 0 || e.away < o.second_opinion_distance) {
+      challenger.reset();
+      return std::nullopt;
+    }
+    if ((c.counted_odometry.translation() - now.translation()).norm() >= o.hypotheses.station_m) {
+      c.log_sum += e.log_ratio;
+      ++c.images;
+      c.counted_odometry = now;
+    }
+    if (c.log_sum >= std::log(o.audit_ratio)) {
+      const double sum = c.log_sum;
+      const int images = c.images;
+      challenger.reset();
+      return audit_loss(e, sum, images, r);
+    }
+    if (c.frames >= o.audit_challenge_frames) challenger.reset();
+    return std::nullopt;
+  }
+
+  LossVerdict audit_loss(const Elsewhere& e, double log_sum, int images, const OmniCheckResult& r) {
+    ++counts.second_opinions;
+    char why[320];
+    if (images == 1)
       std::snprintf(why, sizeof why,
                     "an audit of the omnidirectional view puts the robot %.1f m away, e^%.0f "
                     "times likelier than the estimate, whose near lamps it matches (%d of %d): "
                     "a look-alike place",
-                    away, log_ratio, r.matched, r.expected);
-    } else {
+                    e.away, log_sum, r.matched, r.expected);
+    else
       std::snprintf(why, sizeof why,
-                    "the omnidirectional view does not match the estimate (%d of %d predicted "
-                    "lamps seen) and puts the robot %.1f m away, e^%.0f times likelier",
-                    r.matched, r.expected, away, log_ratio);
-    }
+                    "audits of %d omnidirectional images put the robot %.1f m away, e^%.0f times "
+                    "likelier than the estimate in all, whose near lamps the last matches (%d of "
+                    "%d): a look-alike place",
+                    images, e.away, log_sum, r.matched, r.expected);
     return LossVerdict{ModeCause::omni_locates_elsewhere, why};
   }
 
@@ -260,7 +360,8 @@ struct Localizer::Impl {
   bool audit_due(Stamp stamp) {
     if (o.audit_period <= Duration::zero() || unsure()) return false;
     const bool started = last_audit && stamp >= *last_audit;  // else a new schedule
-    if (started && stamp - *last_audit < o.audit_period) return false;
+    // While a challenger stands, every omni frame weighs it.
+    if (started && !challenger && stamp - *last_audit < o.audit_period) return false;
     last_audit = stamp;
     return started;
   }
@@ -274,7 +375,7 @@ struct Localizer::Impl {
     if (unsure()) return false;
     ++counts.audits;
     evidence = a.stamp;
-    const std::optional<LossVerdict> loss = second_opinion(a.prior, a.check, true);
+    const std::optional<LossVerdict> loss = audit_verdict(a.stamp, a.prior, a.check);
     if (!loss) return true;
     ++counts.audit_losses;
     monitor.reset();

@@ -536,9 +536,9 @@ TEST(Localizer, DomusKidnapEveryJumpDetected) {
   EXPECT_EQ(r.false_alarms, 0);
 }
 
-// Audits (LocalizerOptions::audit_period): one omni frame in 5 s while the estimate is certain,
-// the first of a certain stretch only starting the schedule. The search waits for audit(), so that
-// the frame's pose goes out first, or for the next input.
+// Audits (LocalizerOptions::audit_period): one omni frame in 5 s (here; 2 s by default) while the
+// estimate is certain, the first of a certain stretch only starting the schedule. The search waits
+// for audit(), so that the frame's pose goes out first, or for the next input.
 TEST(Localizer, AuditsRunOnScheduleOnceThePoseIsOut) {
   const World w("maps/office_floor.geojson");
   // Omni frames at 1, 2, ..., 12 s with nothing in them, audit() called after each but the 11th;
@@ -564,9 +564,15 @@ TEST(Localizer, AuditsRunOnScheduleOnceThePoseIsOut) {
   };
   // The frame at 1 s starts the schedule; those at 6 s and 11 s are audited, the second by the
   // wheel reading after it.
-  const auto [ran, audits] = drive({});
+  LocalizerOptions every5;
+  every5.audit_period = std::chrono::seconds(5);
+  const auto [ran, audits] = drive(every5);
   EXPECT_EQ(ran, (std::vector<bool>{0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0}));
   EXPECT_EQ(audits, (std::vector<std::uint64_t>{0, 0, 0, 0, 0, 1, 1, 1, 1, 1, 2}));
+  // By default every 2 s: 3, 5, 7, 9 and 11 s (the last by the wheel reading after it).
+  const auto [ran2, audits2] = drive({});
+  EXPECT_EQ(ran2, (std::vector<bool>{0, 0, 1, 0, 1, 0, 1, 0, 1, 0, 0}));
+  EXPECT_EQ(audits2, (std::vector<std::uint64_t>{0, 0, 1, 1, 2, 2, 3, 3, 4, 4, 5}));
   LocalizerOptions off;
   off.audit_period = Duration::zero();
   EXPECT_EQ(drive(off).second, std::vector<std::uint64_t>(11, 0));
@@ -584,6 +590,30 @@ TEST(Localizer, AuditsRunOnScheduleOnceThePoseIsOut) {
     ADD_FAILURE() << "an audit ratio below 1 was taken";
   } catch (const InputError& e) {
     EXPECT_THAT(e.what(), testing::HasSubstr("audit_ratio"));
+  }
+  off = {};
+  off.audit_step_ratio = 2 * off.audit_ratio;
+  try {
+    const Localizer bad(w.map, w.robot, off);
+    ADD_FAILURE() << "a step ratio above the audit ratio was taken";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), testing::HasSubstr("audit_step_ratio"));
+  }
+  off = {};
+  off.audit_challenge_frames = 0;
+  try {
+    const Localizer bad(w.map, w.robot, off);
+    ADD_FAILURE() << "a challenge of no frames was taken";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), testing::HasSubstr("audit_challenge_frames"));
+  }
+  off = {};
+  off.hypotheses.partial_view_travel_m = -1;
+  try {
+    const Localizer bad(w.map, w.robot, off);
+    ADD_FAILURE() << "a negative travel was taken";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), testing::HasSubstr("partial_view_travel_m"));
   }
 }
 

@@ -80,12 +80,28 @@ struct LocalizerOptions {
   // lamps it had in view fit again) passes every local check: the ceiling camera sees the lamp
   // where the wheels put it and the omni check's near lamps are where the estimate predicts
   // them; only the lamps further off, which the whole frame's search weighs, tell the twin
-  // apart. Each audit costs one global search (docs/localization.md, "Audits"). 0 off.
-  Duration audit_period = std::chrono::seconds(5);
+  // apart. Each audit costs one global search (docs/localization.md, "Audits"). 0 off. The
+  // search of a regular ceiling is cut short (look-alike places tie near the zenith) and finds
+  // the true place in some images only. Carries into the office's twin corridors went unnoticed
+  // for 1.1 to 81 s with audits every 5 s that did not add up, 1.1 to 21.5 s every 2 s adding up,
+  // 1.1 to 17.5 s every 1 s (16 drives carried twice, docs/localization.md, "Audits that add
+  // up").
+  Duration audit_period = std::chrono::seconds(2);
   // The likelihood ratio an audit needs, far above the second opinion's: nothing local doubts
   // the estimate then. Measured: places likelier than a right estimate by at most e^10.4 (a map
   // of part of the building), than a wrong one by e^57.5 to e^79.4. e^30 is about 1e13.
   double audit_ratio = 1e13;
+  // Audits add up. A place more than second_opinion_distance away that an audit finds likelier
+  // than the estimate by audit_step_ratio or more (short of audit_ratio), the challenger, is
+  // carried by the wheels and weighed against the estimate in each omni frame that follows,
+  // refined on it; the images taken at least HypothesisSetOptions::station_m apart add up, and
+  // reaching audit_ratio calls the robot lost. A frame where it is the less likely clears it, as
+  // do audit_challenge_frames frames short of audit_ratio. A carry into the office's twin
+  // corridor (its half turn, or the corridor across it) shows only the rooms that differ: e^9 to
+  // e^28 an image, seldom e^30 in one (docs/localization.md, "Audits that add up"). 1000 is
+  // e^6.9, publish_ratio's figure.
+  double audit_step_ratio = 1000;
+  int audit_challenge_frames = 10;
   // Wheel readings further apart than this (odometry that stopped and came back, a clock that
   // jumped) leave the motion in between unknown: the estimate is no longer certain, and the
   // localizer looks for the robot again (keeping the estimate as one of the places it may be).
