@@ -13,26 +13,35 @@
 namespace lampnav {
 namespace {
 
+// A drive of the bundled office, recorded as `lampnav sim --route 'FROM -> TO' --seed SEED
+// --bumps 0.5 [--kidnap T ...]` records it, read back; and the map built from K1 -> E2.
+struct OfficeDrive {
+  RobotDescription robot = read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  graph::TopologicalMap built = graph::read_map(test::fixture("maps/built_k1_to_e2.geojson")).map;
+  io::MissionLog log;
+  OfficeDrive(const std::string& from, const std::string& to, int seed,
+              const std::vector<double>& kidnaps = {}) {
+    const std::string geojson = test::slurp(test::source_path("maps/office_floor.geojson"));
+    const graph::TopologicalMap office = graph::parse_map(geojson, "office_floor.geojson").map;
+    sim::Scenario drive = sim::make_route_scenario(office, geojson, robot, from, to, seed);
+    for (const double t : kidnaps) drive.kidnaps.push_back({t, std::nullopt});
+    drive.bump_sigma_rad = 0.5 * M_PI / 180;  // as `lampnav sim` records it
+    const std::string path = test::temp_path("partial_map_replay.mcap");
+    sim::record_mission(drive, path);
+    log = io::read_mission_log(path);
+    std::filesystem::remove(path);
+  }
+};
+
 // The first image that made the set complete held one place, 15 m off: its search was kept
 // within the places an image with two seeds allowed, and the true one was not among them.
 // Published at once (min_omni_frames 1), it was the estimate for 30 s and 4 wrong fixes in all;
 // the next image contradicts it, and the set starts again and finds the truth
 // (docs/hypotheses.md, "Three images before a set publishes").
 TEST(PartialMapReplay, ADriveWithoutItsStartIsNeverPublishedWrong) {
-  const std::string geojson = test::slurp(test::source_path("maps/office_floor.geojson"));
-  const graph::TopologicalMap office = graph::parse_map(geojson, "office_floor.geojson").map;
-  const RobotDescription robot =
-      read_robot_description(test::source_path("maps/robots/pioneer.json"));
-  sim::Scenario drive = sim::make_route_scenario(office, geojson, robot, "K1", "E2", 8);
-  drive.bump_sigma_rad = 0.5 * M_PI / 180;  // as `lampnav sim` records it
-  const std::string log_path = test::temp_path("partial_map_replay.mcap");
-  sim::record_mission(drive, log_path);
-  const io::MissionLog log = io::read_mission_log(log_path);
-  std::filesystem::remove(log_path);
-  const graph::TopologicalMap built =
-      graph::read_map(test::fixture("maps/built_k1_to_e2.geojson")).map;
-  const evaluation::Metrics m =
-      evaluation::score(evaluation::replay(log, built, robot, evaluation::ReplayOptions{}), log);
+  const OfficeDrive d("K1", "E2", 8);
+  const evaluation::Metrics m = evaluation::score(
+      evaluation::replay(d.log, d.built, d.robot, evaluation::ReplayOptions{}), d.log);
   std::cout << m.wrong_fixes << " wrong fixes; position RMS " << m.position_error_m.rms * 100
             << " cm over " << m.position_error_m.n << " poses; lost " << m.lost_s << " s\n";
   EXPECT_EQ(m.wrong_fixes, 0);
@@ -53,25 +62,13 @@ TEST(PartialMapReplay, ADriveWithoutItsStartIsNeverPublishedWrong) {
 // drive carried it through the map's walls; now it waits for 8 m of travel
 // (HypothesisSetOptions::partial_view_travel_m, docs/hypotheses.md).
 TEST(PartialMapReplay, ACarryOffTheMapIsNotPublishedOnItsLookAlike) {
-  const std::string geojson = test::slurp(test::source_path("maps/office_floor.geojson"));
-  const graph::TopologicalMap office = graph::parse_map(geojson, "office_floor.geojson").map;
-  const RobotDescription robot =
-      read_robot_description(test::source_path("maps/robots/pioneer.json"));
-  sim::Scenario drive = sim::make_route_scenario(office, geojson, robot, "K2", "Lab 1", 77);
-  drive.kidnaps = {{30, std::nullopt}, {60, std::nullopt}};
-  drive.bump_sigma_rad = 0.5 * M_PI / 180;
-  const std::string log_path = test::temp_path("partial_map_carry.mcap");
-  sim::record_mission(drive, log_path);
-  const io::MissionLog log = io::read_mission_log(log_path);
-  std::filesystem::remove(log_path);
-  const graph::TopologicalMap built =
-      graph::read_map(test::fixture("maps/built_k1_to_e2.geojson")).map;
+  const OfficeDrive d("K2", "Lab 1", 77, {30, 60});
   evaluation::ReplayOptions at_once;
   at_once.runtime.localizer.hypotheses.partial_view_travel_m = 0;
   const evaluation::Metrics before =
-      evaluation::score(evaluation::replay(log, built, robot, at_once), log);
-  const evaluation::ReplayResult r = evaluation::replay(log, built, robot);
-  const evaluation::Metrics m = evaluation::score(r, log);
+      evaluation::score(evaluation::replay(d.log, d.built, d.robot, at_once), d.log);
+  const evaluation::ReplayResult r = evaluation::replay(d.log, d.built, d.robot);
+  const evaluation::Metrics m = evaluation::score(r, d.log);
   bool waited = false;  // the mode said why
   for (const auto& e : r.events)
     waited = waited || e.reason.find("m more of travel") != std::string::npos;
