@@ -576,45 +576,23 @@ TEST(Localizer, AuditsRunOnScheduleOnceThePoseIsOut) {
   LocalizerOptions off;
   off.audit_period = Duration::zero();
   EXPECT_EQ(drive(off).second, std::vector<std::uint64_t>(11, 0));
-  off.audit_period = -std::chrono::seconds(1);
-  try {
-    const Localizer bad(w.map, w.robot, off);
-    ADD_FAILURE() << "a negative audit period was taken";
-  } catch (const InputError& e) {
-    EXPECT_THAT(e.what(), testing::HasSubstr("audit_period"));
-  }
-  off = {};
-  off.audit_ratio = 0.5;
-  try {
-    const Localizer bad(w.map, w.robot, off);
-    ADD_FAILURE() << "an audit ratio below 1 was taken";
-  } catch (const InputError& e) {
-    EXPECT_THAT(e.what(), testing::HasSubstr("audit_ratio"));
-  }
-  off = {};
-  off.audit_step_ratio = 2 * off.audit_ratio;
-  try {
-    const Localizer bad(w.map, w.robot, off);
-    ADD_FAILURE() << "a step ratio above the audit ratio was taken";
-  } catch (const InputError& e) {
-    EXPECT_THAT(e.what(), testing::HasSubstr("audit_step_ratio"));
-  }
-  off = {};
-  off.audit_challenge_frames = 0;
-  try {
-    const Localizer bad(w.map, w.robot, off);
-    ADD_FAILURE() << "a challenge of no frames was taken";
-  } catch (const InputError& e) {
-    EXPECT_THAT(e.what(), testing::HasSubstr("audit_challenge_frames"));
-  }
-  off = {};
-  off.hypotheses.partial_view_travel_m = -1;
-  try {
-    const Localizer bad(w.map, w.robot, off);
-    ADD_FAILURE() << "a negative travel was taken";
-  } catch (const InputError& e) {
-    EXPECT_THAT(e.what(), testing::HasSubstr("partial_view_travel_m"));
-  }
+  // Bad options are refused, naming the field.
+  const auto refused = [&](const auto& set, const char* field) {
+    LocalizerOptions bad_options;
+    set(bad_options);
+    try {
+      const Localizer bad(w.map, w.robot, bad_options);
+      ADD_FAILURE() << "a bad " << field << " was taken";
+    } catch (const InputError& e) {
+      EXPECT_THAT(e.what(), testing::HasSubstr(field));
+    }
+  };
+  refused([](LocalizerOptions& o) { o.audit_period = -std::chrono::seconds(1); }, "audit_period");
+  refused([](LocalizerOptions& o) { o.audit_ratio = 0.5; }, "audit_ratio");
+  refused([](LocalizerOptions& o) { o.audit_step_ratio = 2 * o.audit_ratio; }, "audit_step_ratio");
+  refused([](LocalizerOptions& o) { o.audit_challenge_frames = 0; }, "audit_challenge_frames");
+  refused([](LocalizerOptions& o) { o.hypotheses.partial_view_travel_m = -1; },
+          "partial_view_travel_m");
 }
 
 }  // namespace
