@@ -20,13 +20,6 @@
 #include "pose_grid.hpp"
 
 namespace lampnav::fusion {
-namespace detail {
-std::string one_decimal(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.1f", v);
-  return b;
-}
-}  // namespace detail
 
 namespace {
 constexpr double kDeg = M_PI / 180.0;
@@ -596,8 +589,7 @@ struct HypothesisSet::Impl {
     return view_beyond_map ? std::max(0.0, o.partial_view_travel_m - travel_since_complete) : 0.0;
   }
   void note_travel(Stamp stamp, const OdometryTrack& odo) {
-    if (complete && stamp > completed_at)
-      travel_since_complete = std::max(travel_since_complete, odo.travel(completed_at, stamp));
+    if (complete && stamp > completed_at) travel_since_complete = odo.travel(completed_at, stamp);
   }
 
   void reset(const std::string& why) {
@@ -732,10 +724,13 @@ std::string HypothesisSet::why() const {
         << (m.hs.front().node ? " in " + m.hs.front().node->name : std::string()) << ")";
       if (const int more = m.frames_to_publish() - m.omni_frames; more > 0)
         s << ", waiting for " << more << " more omni frame" << (more > 1 ? "s" : "");
-      if (const double more = m.travel_to_publish(); more > 0)
-        s << ", waiting for " << detail::one_decimal(more)
+      if (const double more = m.travel_to_publish(); more > 0) {
+        char metres[32];
+        std::snprintf(metres, sizeof metres, "%.1f", more);
+        s << ", waiting for " << metres
           << " m more of travel: the view shows lamps beyond the map's places, so the robot may "
              "be where the map has nothing";
+      }
       return s.str();
     case HypothesisVerdict::symmetric:
       s << "the building looks the same from " << m.hs.size() << " places (";

@@ -93,9 +93,8 @@ struct Localizer::Impl {
   // audit_ratio: carried by the wheels and weighed against the estimate in each omni frame that
   // follows, the evidence added up (LocalizerOptions::audit_step_ratio).
   struct Challenger {
-    Pose2 pose;      // at `stamp`
-    Pose2 odometry;  // the dead-reckoned pose at `stamp`
-    Stamp stamp;
+    Pose2 pose;              // at the last frame that weighed it
+    Pose2 odometry;          // the dead-reckoned pose then
     Pose2 counted_odometry;  // where the robot was at the last image counted
     double log_sum = 0;      // ln of the likelihood ratios counted, added up
     int images = 0;          // images counted
@@ -251,13 +250,12 @@ struct Localizer::Impl {
   std::optional<Elsewhere> elsewhere(const FilterState& prior, bool named) {
     const GlobalLocalization g = global->locate(last_omni);
     if (!g.found() || (named && g.ambiguous)) return std::nullopt;
-    const auto far =
-        std::find_if(g.hypotheses.begin(), named ? g.hypotheses.begin() + 1 : g.hypotheses.end(),
-                     [&](const PoseHypothesis& h) {
-                       return (h.pose.translation() - prior.pose().translation()).norm() >=
-                              o.second_opinion_distance;
-                     });
-    if (far == (named ? g.hypotheses.begin() + 1 : g.hypotheses.end())) return std::nullopt;
+    const auto end = named ? g.hypotheses.begin() + 1 : g.hypotheses.end();
+    const auto far = std::find_if(g.hypotheses.begin(), end, [&](const PoseHypothesis& h) {
+      return (h.pose.translation() - prior.pose().translation()).norm() >=
+             o.second_opinion_distance;
+    });
+    if (far == end) return std::nullopt;
     return compared(prior, far->pose);
   }
   // A place weighed against the estimate on the last omni frame.
@@ -296,7 +294,7 @@ struct Localizer::Impl {
     if (e->log_ratio >= std::log(o.audit_ratio)) return audit_loss(*e, e->log_ratio, 1, r);
     if (odometry.empty()) return std::nullopt;
     const Pose2 at = odometry.at(stamp);
-    challenger = Challenger{e->pose, at, stamp, at, e->log_ratio, 1, 1};
+    challenger = Challenger{e->pose, at, at, e->log_ratio, 1, 1};
     return std::nullopt;
   }
 
@@ -316,7 +314,6 @@ struct Localizer::Impl {
     const Elsewhere e = compared(prior, there);
     c.pose = there;
     c.odometry = now;
-    c.stamp = stamp;
     ++c.frames;
     if (e.log_ratio < 0 || e.away < o.second_opinion_distance) {
       challenger.reset();
