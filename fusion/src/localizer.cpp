@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "audits.hpp"
 #include "ceiling_rays.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/vision/camera_models.hpp"
@@ -80,27 +81,14 @@ struct Localizer::Impl {
   vision::OmniDetection last_omni;
   Stamp last_omni_stamp;
   std::optional<Stamp> last_omni_check;
-  std::optional<Stamp> last_audit;
-  // An omni frame to audit (its capture time, the estimate then and its check), left for
-  // Localizer::audit() or the next input; last_omni is still that frame's.
   struct PendingAudit {
     Stamp stamp;
     FilterState prior;
     OmniCheckResult check;
   };
   std::optional<PendingAudit> pending_audit;
-  // A place an audit found likelier than the estimate by audit_step_ratio or more, short of
-  // audit_ratio: carried by the wheels and weighed against the estimate in each omni frame that
-  // follows, the evidence added up (LocalizerOptions::audit_step_ratio).
-  struct Challenger {
-    Pose2 pose;              // at the last frame that weighed it
-    Pose2 odometry;          // the dead-reckoned pose then
-    Pose2 counted_odometry;  // where the robot was at the last image counted
-    double log_sum = 0;      // ln of the likelihood ratios counted, added up
-    int images = 0;          // images counted
-    int frames = 0;          // frames weighed
-  };
-  std::optional<Challenger> challenger;
+  // Second opinions and audits of the omni view while the estimate is certain.
+  std::optional<detail::Auditor> auditor;
   std::vector<LocalizerEvent> events;
   Stamp evidence;  // capture time of the input being taken in (LocalizerEvent::evidence)
   LocalizerCounts counts;
@@ -128,6 +116,7 @@ struct Localizer::Impl {
       omni_detector.emplace(*c, o.omni_detector);
       omni_check.emplace(m, *c, o.omni_check);
       global.emplace(m, *c, o.global);
+      auditor.emplace(*global, o);
     }
     hypotheses.emplace(m, ceiling_camera, global ? &*global : nullptr, o.ceiling, o.hypotheses);
   }
@@ -150,8 +139,7 @@ struct Localizer::Impl {
     mode = m;
     events.push_back({now(), m, cause, why, evidence});
     if (unsure() && !was_unsure) {
-      last_audit.reset();  // audits start again with the next certain stretch
-      challenger.reset();
+      if (auditor) auditor->reset();    // audits start again with the next certain stretch
       if (pipeline) pipeline->reset();  // its labels are worthless
       calibration.forget_measurements();
     }
@@ -237,132 +225,6 @@ struct Localizer::Impl {
     settle(stamp);
   }
 
-  // The likeliest place an omni frame's search finds more than second_opinion_distance from the
-  // estimate, and ln of how much likelier than the estimate it is. Both poses are scored alike
-  // (the estimate's uncertainty for both), so the ratio compares the places, not their
-  // refinement. `named`: only a search that names one place (not ambiguous) answers, and only
-  // with that place.
-  struct Elsewhere {
-    Pose2 pose;
-    double away = 0;       // m
-    double log_ratio = 0;  // ln L(there) - ln L(estimate)
-  };
-  std::optional<Elsewhere> elsewhere(const FilterState& prior, bool named) {
-    const GlobalLocalization g = global->locate(last_omni);
-    if (!g.found() || (named && g.ambiguous)) return std::nullopt;
-    const auto end = named ? g.hypotheses.begin() + 1 : g.hypotheses.end();
-    const auto far = std::find_if(g.hypotheses.begin(), end, [&](const PoseHypothesis& h) {
-      return (h.pose.translation() - prior.pose().translation()).norm() >=
-             o.second_opinion_distance;
-    });
-    if (far == end) return std::nullopt;
-    return compared(prior, far->pose);
-  }
-  // A place weighed against the estimate on the last omni frame.
-  Elsewhere compared(const FilterState& prior, const Pose2& there_pose) const {
-    const double sp = std::clamp(std::sqrt(std::max(prior.P(0, 0), prior.P(1, 1))), 0.05, 0.5);
-    const double sy = std::clamp(std::sqrt(prior.P(2, 2)), 0.5 * kDeg, 5 * kDeg);
-    const double here = global->score(prior.pose(), sp, sy, last_omni).cost;
-    const double there = global->score(there_pose, sp, sy, last_omni).cost;
-    return Elsewhere{there_pose, (there_pose.translation() - prior.pose().translation()).norm(),
-                     0.5 * (here - there)};
-  }
-
-  // An omni check disagreed with the estimate once: does the frame itself put the robot
-  // elsewhere, far more likely than where the estimate is?
-  std::optional<LossVerdict> second_opinion(const FilterState& prior, const OmniCheckResult& r) {
-    if (o.second_opinion_ratio <= 0) return std::nullopt;
-    const std::optional<Elsewhere> e = elsewhere(prior, true);
-    if (!e || e->log_ratio < std::log(o.second_opinion_ratio)) return std::nullopt;
-    ++counts.second_opinions;
-    char why[240];
-    std::snprintf(why, sizeof why,
-                  "the omnidirectional view does not match the estimate (%d of %d predicted "
-                  "lamps seen) and puts the robot %.1f m away, e^%.0f times likelier",
-                  r.matched, r.expected, e->away, e->log_ratio);
-    return LossVerdict{ModeCause::omni_locates_elsewhere, why};
-  }
-
-  // An audit: the frame's search asked whether some place away from the estimate is likelier.
-  // One likelier by audit_ratio proves a loss; one likelier by audit_step_ratio becomes the
-  // challenger, which the frames that follow weigh (challenge()).
-  std::optional<LossVerdict> audit_verdict(Stamp stamp, const FilterState& prior,
-                                           const OmniCheckResult& r) {
-    if (challenger) return challenge(stamp, prior, r);
-    const std::optional<Elsewhere> e = elsewhere(prior, false);
-    if (!e || e->log_ratio < std::log(o.audit_step_ratio)) return std::nullopt;
-    if (e->log_ratio >= std::log(o.audit_ratio)) return audit_loss(*e, e->log_ratio, 1, r);
-    if (odometry.empty()) return std::nullopt;
-    const Pose2 at = odometry.at(stamp);
-    challenger = Challenger{e->pose, at, at, e->log_ratio, 1, 1};
-    return std::nullopt;
-  }
-
-  // The challenger carried to this frame by the wheels, refined on it, and weighed against the
-  // estimate: a frame where it is the less likely clears it; the images taken at least
-  // HypothesisSetOptions::station_m apart add up (one spot's images repeat one image's
-  // evidence), up to audit_ratio: a loss. Cleared after audit_challenge_frames frames short of
-  // it.
-  std::optional<LossVerdict> challenge(Stamp stamp, const FilterState& prior,
-                                       const OmniCheckResult& r) {
-    Challenger& c = *challenger;
-    const Pose2 now = odometry.at(stamp);
-    Pose2 there = c.pose * c.odometry.between(now);
-    if (const std::optional<PoseHypothesis> refined =
-            global->refine(there, 0.3, 3 * kDeg, last_omni))
-      there = refined->pose;
-    const Elsewhere e = compared(prior, there);
-    c.pose = there;
-    c.odometry = now;
-    ++c.frames;
-    if (e.log_ratio < 0 || e.away < o.second_opinion_distance) {
-      challenger.reset();
-      return std::nullopt;
-    }
-    if ((c.counted_odometry.translation() - now.translation()).norm() >= o.hypotheses.station_m) {
-      c.log_sum += e.log_ratio;
-      ++c.images;
-      c.counted_odometry = now;
-    }
-    if (c.log_sum >= std::log(o.audit_ratio)) {
-      const double sum = c.log_sum;
-      const int images = c.images;
-      challenger.reset();
-      return audit_loss(e, sum, images, r);
-    }
-    if (c.frames >= o.audit_challenge_frames) challenger.reset();
-    return std::nullopt;
-  }
-
-  LossVerdict audit_loss(const Elsewhere& e, double log_sum, int images, const OmniCheckResult& r) {
-    ++counts.second_opinions;
-    char why[320];
-    if (images == 1)
-      std::snprintf(why, sizeof why,
-                    "an audit of the omnidirectional view puts the robot %.1f m away, e^%.0f "
-                    "times likelier than the estimate, whose near lamps it matches (%d of %d): "
-                    "a look-alike place",
-                    e.away, log_sum, r.matched, r.expected);
-    else
-      std::snprintf(why, sizeof why,
-                    "audits of %d omnidirectional images put the robot %.1f m away, e^%.0f times "
-                    "likelier than the estimate in all, whose near lamps the last matches (%d of "
-                    "%d): a look-alike place",
-                    images, e.away, log_sum, r.matched, r.expected);
-    return LossVerdict{ModeCause::omni_locates_elsewhere, why};
-  }
-
-  // Whether an omni frame is audited: on schedule while the estimate is certain (the first
-  // frame of a certain stretch starts the schedule, so a fix is not audited by its own image).
-  bool audit_due(Stamp stamp) {
-    if (o.audit_period <= Duration::zero() || unsure()) return false;
-    const bool started = last_audit && stamp >= *last_audit;  // else a new schedule
-    // While a challenger stands, every omni frame weighs it.
-    if (started && !challenger && stamp - *last_audit < o.audit_period) return false;
-    last_audit = stamp;
-    return started;
-  }
-
   // The pending audit, if the estimate is still certain: a loss it proves is declared on its
   // frame's evidence, and that frame is the first the hypotheses weigh.
   bool run_audit() {
@@ -372,8 +234,10 @@ struct Localizer::Impl {
     if (unsure()) return false;
     ++counts.audits;
     evidence = a.stamp;
-    const std::optional<LossVerdict> loss = audit_verdict(a.stamp, a.prior, a.check);
+    const std::optional<LossVerdict> loss =
+        auditor->audit(a.stamp, a.prior, a.check, last_omni, odometry);
     if (!loss) return true;
+    ++counts.second_opinions;
     ++counts.audit_losses;
     monitor.reset();
     lose(loss);
@@ -696,8 +560,11 @@ void Localizer::omni_detection(Stamp stamp, const vision::OmniDetection& detecti
                "the omnidirectional view agrees with the relocalized pose");
   std::optional<LossVerdict> loss = m.monitor.omni(r);
   if (!loss && r.conclusive && !r.consistent) {
-    loss = m.second_opinion(*prior, r);
-    if (loss) m.monitor.reset();
+    loss = m.auditor->second_opinion(*prior, r, m.last_omni);
+    if (loss) {
+      ++m.counts.second_opinions;
+      m.monitor.reset();
+    }
   }
   m.lose(loss);
   if (m.unsure()) {
@@ -705,7 +572,7 @@ void Localizer::omni_detection(Stamp stamp, const vision::OmniDetection& detecti
     return;
   }
   // (A frame the check found inconsistent was asked the same already: second_opinion.)
-  if (m.audit_due(stamp) && !(r.conclusive && !r.consistent))
+  if (m.auditor->due(stamp) && !(r.conclusive && !r.consistent))
     m.pending_audit = Impl::PendingAudit{stamp, *prior, r};
   if (m.o.omni_update_min_lamps > 0 && (r.conclusive ? r.consistent : m.o.omni_update_unchecked))
     m.omni_update(stamp, *prior, r.conclusive);
