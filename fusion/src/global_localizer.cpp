@@ -206,7 +206,7 @@ std::vector<GlobalLocalizer::Impl::BlobRay> GlobalLocalizer::Impl::blob_rays(
   std::vector<BlobRay> out;
   for (std::size_t j = 0; j < d.blobs.size(); ++j) {
     const auto& b = d.blobs[j];
-    if (b.theta <= max_theta) out.push_back({b.ray, b.theta, b.angular_radius, int(j)});
+    if (b.theta <= max_theta) out.push_back({b.ray, b.theta, b.angular_radius, int(j), &b});
   }
   return out;
 }
@@ -399,11 +399,19 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
     }
     return false;
   };
+  // A streak (lamps of a row merged) lies over the lamps along it, to its ends: the disc of its
+  // area covers the middle of a streak running from overhead to the horizon, and the far lamps
+  // of the robot's own corridor, under it, were counted missing where a twin place with no lamps
+  // there was not (a regular building, docs/hypotheses.md, "Streaks").
   const auto covered = [&](const Predicted& p) {
     const double reach = p.half_size + q.cover_sigmas * p.sigma;
     for (const BlobRay& b : blobs) {
       const double cover = reach + b.angular_radius;
       if ((p.ray - b.ray).squaredNorm() < cover * cover) return true;
+      if (!b.blob->streak) continue;
+      const double width = reach + b.blob->streak_half_width;
+      for (const Vector3d& end : b.blob->streak_ends)
+        if (detail::distance_to_segment(p.ray, b.ray, end) < width) return true;
     }
     return false;
   };

@@ -27,10 +27,19 @@ using Eigen::Vector3d;
 
 constexpr double kDeg = M_PI / 180.0;
 
+// Distance (a chord, as between unit rays) from p to the segment a-b.
+inline double distance_to_segment(const Vector3d& p, const Vector3d& a, const Vector3d& b) {
+  const Vector3d ab = b - a;
+  const double len2 = ab.squaredNorm();
+  const double t = len2 > 0 ? std::clamp((p - a).dot(ab) / len2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
 struct BlobRay {
   Vector3d ray;  // camera frame
   double theta, angular_radius;
-  int index;  // into the detection's blobs
+  int index;                     // into the detection's blobs
+  const vision::OmniBlob* blob;  // its streak's ends and width (vision::OmniBlob)
 };
 
 // The blobs of one image by where their rays point, to find those within a chord of a ray

@@ -3,6 +3,7 @@
 
 #include "lampnav/vision/omni_detector.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <random>
 
 #include "lampnav/core/error.hpp"
@@ -154,6 +155,59 @@ TEST(OmniLampDetector, ABloomSplitsOnlyItsOwnPixels) {
   }
   EXPECT_EQ(lamp, 1);
   EXPECT_EQ(cores, 2);
+}
+
+// A streak (a row of lamps bloomed together) keeps the ends of its long axis and its width: the
+// moments summed run by run equal those of its pixels, whichever way the rows run. A blob about
+// as wide as long is no streak.
+TEST(OmniLampDetector, AStreakKeepsTheEndsOfItsLongAxis) {
+  Museum m;
+  OmniLampDetector det(m.cam);
+  const FisheyeCamera model(m.cam);
+  Image8 img(m.cam.width, m.cam.height, 0);
+  std::vector<Eigen::Vector2d> pixels;
+  const auto light = [&](int u, int v) {
+    img.at(u, v) = 255;
+    pixels.emplace_back(u, v);
+  };
+  // Down and to the left, two pixels wide: later rows start left of the first.
+  for (int t = 0; t < 80; ++t) {
+    light(700 - t, 300 + t);
+    light(701 - t, 300 + t);
+  }
+  // A 12 x 10 rectangle elsewhere.
+  for (int v = 600; v < 610; ++v)
+    for (int u = 300; u < 312; ++u) img.at(u, v) = 255;
+  const OmniDetection d = det.detect(ImageView::of(img));
+  ASSERT_EQ(d.blobs.size(), 2u);
+  const OmniBlob& streak = d.blobs[0].pixels == 160 ? d.blobs[0] : d.blobs[1];
+  const OmniBlob& box = d.blobs[0].pixels == 160 ? d.blobs[1] : d.blobs[0];
+  EXPECT_FALSE(box.streak);
+  ASSERT_TRUE(streak.streak);
+
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& p : pixels) mean += p / pixels.size();
+  Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+  for (const auto& p : pixels) cov += (p - mean) * (p - mean).transpose() / pixels.size();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+  const Eigen::Vector2d along = std::sqrt(3 * eig.eigenvalues()(1)) * eig.eigenvectors().col(1);
+  std::vector<Eigen::Vector2d> ends;
+  for (const Eigen::Vector3d& ray : streak.streak_ends) {
+    const auto px = model.project(ray);
+    ASSERT_TRUE(px);
+    ends.push_back(*px);
+  }
+  if ((ends[0] - (mean + along)).norm() > (ends[0] - (mean - along)).norm())
+    std::swap(ends[0], ends[1]);
+  EXPECT_LT((ends[0] - (mean + along)).norm(), 1e-6);
+  EXPECT_LT((ends[1] - (mean - along)).norm(), 1e-6);
+  // The ends of a uniform streak: its first and last pixels, within a pixel.
+  EXPECT_LT(std::min((ends[0] - Eigen::Vector2d(700.5, 300)).norm(),
+                     (ends[1] - Eigen::Vector2d(700.5, 300)).norm()),
+            1.0);
+  // Its half width, sqrt(3) of the short axis's sigma, in radians at the blob's radial scale.
+  const double scale = model.radius_derivative(streak.theta);
+  EXPECT_NEAR(streak.streak_half_width * scale, std::sqrt(3 * eig.eigenvalues()(0)), 0.02);
 }
 
 TEST(OmniLampDetector, BlackSpecksAndWrongImages) {

@@ -36,16 +36,30 @@ struct OmniLampDetector::Impl {
   // blob is outside the usable view.
   bool describe(const detail::BlobLabeller& lab, const detail::Blob& b, int du, int dv,
                 OmniBlob* out) const {
-    double su = 0, sv = 0;
+    // First and second moments of the pixels, about the first run's start (for precision).
+    const detail::Run& origin = lab.run(b.first_run);
+    double su = 0, sv = 0, suu = 0, svv = 0, suv = 0;
+    const auto sum_squares = [](double m) { return m * (m + 1) * (2 * m + 1) / 6; };  // 1..m
     for (int k = 0; k < b.run_count; ++k) {
       const detail::Run& r = lab.run(b.first_run + k);
       const double n = r.u1 - r.u0 + 1;
-      su += n * (r.u0 + r.u1) / 2.0;
-      sv += n * r.row;
+      const double u0 = r.u0 - origin.u0, u1 = r.u1 - origin.u0, v = r.row - origin.row;
+      const double run_u = n * (u0 + u1) / 2.0;
+      // The sum of u^2 over u0..u1, for u0 and u1 of either sign.
+      const double run_uu = u0 >= 0 ? sum_squares(u1) - sum_squares(u0 - 1)
+                                    : (u1 >= 0 ? sum_squares(-u0) + sum_squares(u1)
+                                               : sum_squares(-u0) - sum_squares(-u1 - 1));
+      su += run_u;
+      sv += n * v;
+      suu += run_uu;
+      svv += n * v * v;
+      suv += v * run_u;
     }
+    const double N = b.pixels;
+    const double mu = su / N, mv = sv / N;
     out->pixels = b.pixels;
     out->perimeter = lab.perimeter(b);
-    out->centroid_px = Eigen::Vector2d(su / b.pixels + du, sv / b.pixels + dv);
+    out->centroid_px = Eigen::Vector2d(mu + origin.u0 + du, mv + origin.row + dv);
     const auto& p = model.parameters();
     const Eigen::Vector2d d(out->centroid_px.x() - p.u0, (out->centroid_px.y() - p.v0) / p.beta);
     out->radius_px = d.norm();
@@ -55,7 +69,25 @@ struct OmniLampDetector::Impl {
     out->ray = ray->normalized();
     out->theta = std::atan2(out->ray.head<2>().norm(), out->ray.z());
     const double dr_dtheta = (model.radius(out->theta + 1e-3) - model.radius(out->theta)) / 1e-3;
-    out->angular_radius = std::sqrt(b.pixels / M_PI) / std::max(1.0, dr_dtheta);
+    const double scale = std::max(1.0, dr_dtheta);  // px a radian
+    out->angular_radius = std::sqrt(b.pixels / M_PI) / scale;
+    // The pixels' covariance, its axes: a streak when the long one is twice the short one.
+    const double cuu = suu / N - mu * mu, cvv = svv / N - mv * mv, cuv = suv / N - mu * mv;
+    const double mean = (cuu + cvv) / 2, diff = std::hypot((cuu - cvv) / 2, cuv);
+    const double long_var = mean + diff, short_var = std::max(0.0, mean - diff);
+    if (long_var >= 4 * short_var && long_var > 0) {
+      const double angle = 0.5 * std::atan2(2 * cuv, cuu - cvv);
+      const Eigen::Vector2d along =
+          std::sqrt(3 * long_var) * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+      const auto end0 = model.unproject(out->centroid_px + along);
+      const auto end1 = model.unproject(out->centroid_px - along);
+      if (end0 && end1) {
+        out->streak = true;
+        out->streak_ends[0] = end0->normalized();
+        out->streak_ends[1] = end1->normalized();
+        out->streak_half_width = std::sqrt(3 * short_var) / scale;
+      }
+    }
     return out->theta <= o.max_theta_deg * M_PI / 180;
   }
 

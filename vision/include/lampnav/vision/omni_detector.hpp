@@ -35,6 +35,13 @@ struct OmniBlob {
   Eigen::Vector3d ray = Eigen::Vector3d::UnitZ();  // unit direction in the camera frame
   double angular_radius = 0;  // rad, the radius of a disc of its area, seen from the camera
   bool from_bloom = false;    // split out of a big blob by the second threshold
+  // A streak: a blob at least twice as long as it is wide (lamps of a row merged into one
+  // bloom, from overhead to the horizon). Its disc of the same area hides most of it, so the
+  // directions of the ends of its long axis are kept, sqrt(3) standard deviations of its pixels
+  // from the centroid (a uniform streak's ends), and its half width across it (rad).
+  bool streak = false;
+  Eigen::Vector3d streak_ends[2] = {Eigen::Vector3d::UnitZ(), Eigen::Vector3d::UnitZ()};
+  double streak_half_width = 0;
 };
 
 struct OmniDetection {
