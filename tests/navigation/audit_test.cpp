@@ -9,7 +9,6 @@
 // lamps 15 m and more away (the grid's edge, the lobby, the missing corridor) differ.
 
 #include <cmath>
-#include <filesystem>
 #include <iostream>
 
 #include "lampnav/evaluation/replay.hpp"
@@ -18,6 +17,7 @@
 #include "lampnav/sim/building.hpp"
 #include "lampnav/sim/scenario.hpp"
 #include "lampnav_test.hpp"
+#include "recorded_drive.hpp"
 
 namespace lampnav {
 namespace {
@@ -41,10 +41,7 @@ struct TwinCarry {
     sim::Scenario s = sim::make_route_scenario(map, geojson, robot, "J2_2", "Lobby", 38);
     s.kidnaps = {{25, std::nullopt}, {60, std::nullopt}};
     s.bump_sigma_rad = 1.2 * M_PI / 180;
-    const std::string path = test::temp_path("twin_carry.mcap");
-    sim::record_mission(s, path);
-    log = io::read_mission_log(path);
-    std::filesystem::remove(path);
+    log = test::recorded_drive(s, "twin_carry.mcap");
   }
 };
 
@@ -99,10 +96,7 @@ TEST(Audit, ACarryIntoTheOfficesTwinCorridorIsFoundByAuditsThatAddUp) {
   sim::Scenario s = sim::make_route_scenario(office, geojson, robot, "Lab 3", "E2", 92);
   s.kidnaps = {{25, std::nullopt}, {55, std::nullopt}};
   s.bump_sigma_rad = 0.5 * M_PI / 180;
-  const std::string path = test::temp_path("office_twin_carry.mcap");
-  sim::record_mission(s, path);
-  const io::MissionLog log = io::read_mission_log(path);
-  std::filesystem::remove(path);
+  const io::MissionLog log = test::recorded_drive(s, "office_twin_carry.mcap");
 
   // When the localizer first leaves the certain modes after the second carry, and the audits that
   // called it lost other than in the 25 s after a carry.

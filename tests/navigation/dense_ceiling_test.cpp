@@ -5,7 +5,6 @@
 // overhead to the horizon, which the second threshold does not split.
 
 #include <cmath>
-#include <filesystem>
 #include <iostream>
 
 #include "lampnav/evaluation/replay.hpp"
@@ -14,6 +13,7 @@
 #include "lampnav/sim/building.hpp"
 #include "lampnav/sim/scenario.hpp"
 #include "lampnav_test.hpp"
+#include "recorded_drive.hpp"
 
 namespace lampnav {
 namespace {
@@ -41,10 +41,7 @@ TEST(DenseCeiling, LampsMergedIntoAStreakAreNotCountedMissing) {
   s.kidnaps = {{25, std::nullopt}, {60, std::nullopt}};
   s.bump_sigma_rad = 1.0 * M_PI / 180;
   s.max_duration_s = 100;  // the twin was published at 74.5 s
-  const std::string path = test::temp_path("dense_ceiling.mcap");
-  sim::record_mission(s, path);
-  const io::MissionLog log = io::read_mission_log(path);
-  std::filesystem::remove(path);
+  const io::MissionLog log = test::recorded_drive(s, "dense_ceiling.mcap");
 
   const evaluation::ReplayResult r = evaluation::replay(log, map, robot);
   const evaluation::Metrics m = evaluation::score(r, log);

@@ -9,6 +9,7 @@
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/sim/scenario.hpp"
 #include "lampnav_test.hpp"
+#include "recorded_drive.hpp"
 
 namespace lampnav {
 namespace {
@@ -26,10 +27,7 @@ struct OfficeDrive {
     sim::Scenario drive = sim::make_route_scenario(office, geojson, robot, from, to, seed);
     for (const double t : kidnaps) drive.kidnaps.push_back({t, std::nullopt});
     drive.bump_sigma_rad = 0.5 * M_PI / 180;  // as `lampnav sim` records it
-    const std::string path = test::temp_path("partial_map_replay.mcap");
-    sim::record_mission(drive, path);
-    log = io::read_mission_log(path);
-    std::filesystem::remove(path);
+    log = test::recorded_drive(drive, "partial_map_replay.mcap");
   }
 };
 
