@@ -39,19 +39,17 @@ struct OmniLampDetector::Impl {
     // First and second moments of the pixels, about the first run's start (for precision).
     const detail::Run& origin = lab.run(b.first_run);
     double su = 0, sv = 0, suu = 0, svv = 0, suv = 0;
-    const auto sum_squares = [](double m) { return m * (m + 1) * (2 * m + 1) / 6; };  // 1..m
+    // 1^2 + ... + m^2; as a polynomial S(m) - S(m - 1) = m^2 for every integer m, so the sum of
+    // u^2 over u0..u1 is S(u1) - S(u0 - 1) whatever their signs.
+    const auto sum_squares = [](double m) { return m * (m + 1) * (2 * m + 1) / 6; };
     for (int k = 0; k < b.run_count; ++k) {
       const detail::Run& r = lab.run(b.first_run + k);
       const double n = r.u1 - r.u0 + 1;
       const double u0 = r.u0 - origin.u0, u1 = r.u1 - origin.u0, v = r.row - origin.row;
       const double run_u = n * (u0 + u1) / 2.0;
-      // The sum of u^2 over u0..u1, for u0 and u1 of either sign.
-      const double run_uu = u0 >= 0 ? sum_squares(u1) - sum_squares(u0 - 1)
-                                    : (u1 >= 0 ? sum_squares(-u0) + sum_squares(u1)
-                                               : sum_squares(-u0) - sum_squares(-u1 - 1));
       su += run_u;
       sv += n * v;
-      suu += run_uu;
+      suu += sum_squares(u1) - sum_squares(u0 - 1);
       svv += n * v * v;
       suv += v * run_u;
     }
