@@ -66,8 +66,8 @@ struct OmniLampDetector::Impl {
     if (!ray) return false;
     out->ray = ray->normalized();
     out->theta = std::atan2(out->ray.head<2>().norm(), out->ray.z());
-    const double dr_dtheta = (model.radius(out->theta + 1e-3) - model.radius(out->theta)) / 1e-3;
-    const double scale = std::max(1.0, dr_dtheta);  // px a radian
+    // px a radian at the blob: the lens model's own derivative of its radius.
+    const double scale = std::max(1.0, model.radius_derivative(out->theta));
     out->angular_radius = std::sqrt(b.pixels / M_PI) / scale;
     // The pixels' covariance, its axes: a streak when the long one is twice the short one.
     const double cuu = suu / N - mu * mu, cvv = svv / N - mv * mv, cuv = suv / N - mu * mv;
