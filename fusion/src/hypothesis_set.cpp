@@ -7,14 +7,11 @@
 #include <limits>
 #include <map>
 #include <optional>
-#include <set>
 #include <sstream>
 
+#include "hypothesis_weighing.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/core/parallel.hpp"
-#include "lampnav/fusion/ceiling_geometry.hpp"
-#include "lampnav/fusion/chi_square.hpp"
-#include "lampnav/vision/camera_models.hpp"
 #include "map_evidence.hpp"
 #include "map_geometry.hpp"
 #include "pose_grid.hpp"
@@ -30,15 +27,7 @@ struct HypothesisSet::Impl {
   const graph::TopologicalMap* map;
   HypothesisSetOptions o;
   const GlobalLocalizer* omni;
-  std::optional<LampLabeller> labeller;
-  std::optional<CeilingGeometry> geometry;
-  std::optional<vision::PinholeCamera> camera;
-  std::optional<vision::LampShapePrior> kind;  // the lamps the ceiling camera looks for
-  PoseMeasurementOptions measurement;
-  // Where a stray ceiling sighting is placed: the usual height of the lamps the ceiling camera
-  // looks for (their shape prior's nominal distance, above the floor).
-  double lamp_height = 0;
-  double fit_gate = 0;  // the ceiling fit's normalized innovation the map's errors explain
+  detail::HypothesisWeigher weigher;  // what a frame says of one hypothesis
   bool has_regions = false;
 
   std::vector<Hypothesis> hs;  // best first after every frame
@@ -83,21 +72,14 @@ struct HypothesisSet::Impl {
     return true;
   }
 
+  static HypothesisSetOptions validated(const HypothesisSetOptions& opt) {
+    opt.validate();
+    return opt;
+  }
+
   Impl(const graph::TopologicalMap& m, const CameraDescription* ceiling_camera,
        const GlobalLocalizer* g, const CeilingPipelineOptions& co, const HypothesisSetOptions& opt)
-      : map(&m), o(opt), omni(g), measurement(co.measurement) {
-    o.validate();
-    measurement.map_sigma = std::max(measurement.map_sigma, o.map_sigma_m);
-    fit_gate = chi_square_quantile(o.fit_gate_probability, 3);
-    if (ceiling_camera) {
-      LabellerOptions lo = co.labeller;
-      lo.map_sigma = std::max(lo.map_sigma, o.map_sigma_m);
-      labeller.emplace(m, *ceiling_camera, lo);
-      geometry.emplace(*ceiling_camera);
-      camera.emplace(*ceiling_camera);
-      kind = shape_prior_for(m, *ceiling_camera);
-      lamp_height = kind->nominal_distance + ceiling_camera->mount.xyz.z();
-    }
+      : map(&m), o(validated(opt)), omni(g), weigher(m, ceiling_camera, g, co, o) {
     for (const auto& n : m.nodes())
       if (n.region.size() >= 3) has_regions = true;
   }
@@ -127,151 +109,6 @@ struct HypothesisSet::Impl {
     return c;
   }
 
-  // Kalman update of a hypothesis with a pose measurement (map_geometry.hpp), its covariance no
-  // smaller than odometry between frames allows; returns the normalized innovation squared less
-  // its expectation (3).
-  double update(Hypothesis& h, const Pose2& z, const Eigen::Matrix3d& R) const {
-    return detail::update_pose(h.pose, h.covariance, z, R, o.sigma_m, o.sigma_yaw_deg * kDeg);
-  }
-
-  static double sigma_position(const Eigen::Matrix3d& P) {
-    return std::sqrt(std::max(P(0, 0), P(1, 1)));
-  }
-
-  // Whether an omni stray places its lamp well enough to be charged to a spot: near enough, and
-  // within its reach of one of the map's places unless count_beyond_map. (Asked only of the near
-  // ones: a far stray's reach spans many places, and the search through them cost as much as
-  // weighing the hypothesis.)
-  bool placed(const StraySighting& b) const {
-    return b.reach <= o.stray_reach_max_m && (o.count_beyond_map || !beyond_places(b));
-  }
-  // Whether a stray's lamp would lie beyond every place of the map (further than its reach).
-  bool beyond_places(const StraySighting& b) const {
-    return map->node_near(b.at, b.reach) == nullptr;
-  }
-  int placed_strays(const std::vector<StraySighting>& strays) const {
-    return static_cast<int>(std::count_if(strays.begin(), strays.end(),
-                                          [&](const StraySighting& b) { return placed(b); }));
-  }
-  // What an image's `unexplained` blobs that place no lamp well enough for a spot (all but
-  // `spots` of them, placed_strays) cost in full: the far account's charge before its bound.
-  double far_cost(int unexplained, int spots) const {
-    return omni->options().pairs.spurious_cost * std::max(0, unexplained - spots);
-  }
-
-  // Charges what an omni image said of a hypothesis to its ledgers (map_evidence.hpp): the lamps
-  // it missed, its `unexplained` blobs no lamp explains (those placed well enough to a spot, the
-  // rest to the far account), what each lamp's directions cost. Returns what the ledgers charged
-  // less what the image's score counted for them in full.
-  double charge_image(Hypothesis& h, const std::vector<const graph::Lamp*>& missed, int unexplained,
-                      const std::vector<StraySighting>& strays,
-                      const std::vector<std::pair<const graph::Lamp*, double>>& lamp_costs) const {
-    const double each = omni->options().pairs.miss_cost;
-    const double stray = omni->options().pairs.spurious_cost;
-    double delta = detail::charge_absences(h.map_costs.lamps, missed, each, o.lamp_out_cost) -
-                   each * static_cast<double>(missed.size());
-    int spots = 0;  // placed() asks the map: once a stray
-    for (const StraySighting& b : strays)
-      if (placed(b)) {
-        ++spots;
-        delta += detail::charge_stray(h.map_costs.strays, b.at, std::max(o.stray_radius_m, b.reach),
-                                      stray, o.unmapped_lamp_cost) -
-                 stray;
-      }
-    const double far = far_cost(unexplained, spots);
-    delta += detail::charge_account(h.map_costs.far_strays, far, o.far_stray_cost_max) - far;
-    for (const auto& [l, c] : lamp_costs)
-      delta += detail::charge_misfit(h.map_costs.misfits, l, c, o.lamp_out_cost) - c;
-    return delta;
-  }
-
-  // What one frame says of one hypothesis: -2 ln L, and whether it plainly contradicts it (most
-  // of the lamps it predicts in clear view unseen, or most of the lamps seen unexplained).
-  struct Weighed {
-    double cost = 0;
-    bool contradicted = false;
-  };
-  static bool contradicts(int expected, int missing, int seen, int unexplained) {
-    return (expected >= 3 && 2 * missing > expected) || (seen >= 4 && 2 * unexplained > seen);
-  }
-
-  // An omni frame for one hypothesis (carried to the frame), updating it.
-  Weighed weigh_omni(Hypothesis& h, const vision::OmniDetection& d) const {
-    const double ps = std::clamp(sigma_position(h.covariance), 0.03, 1.5);
-    const double ys = std::clamp(std::sqrt(h.covariance(2, 2)), 0.5 * kDeg, 15 * kDeg);
-    const std::optional<PoseHypothesis> r = omni->refine(h.pose, ps, ys, d);
-    if (r && r->matches.size() >= 2) {
-      Eigen::Matrix3d R = r->covariance;
-      R.diagonal() += Eigen::Vector3d(o.omni_bump_sigma_m * o.omni_bump_sigma_m,
-                                      o.omni_bump_sigma_m * o.omni_bump_sigma_m,
-                                      std::pow(o.omni_bump_sigma_deg * kDeg, 2));
-      const int seen = static_cast<int>(r->matches.size()) + r->unexplained;
-      // A misfit better than expected says nothing (map_evidence.hpp, charge_misfit).
-      return {r->score + charge_image(h, r->missed, r->unexplained, r->strays, r->lamp_costs) +
-                  std::max(0.0, update(h, r->pose, R)),
-              contradicts(r->expected, r->missing, seen, r->unexplained)};
-    }
-    // Nothing to refine on: the prediction scored as it stands, with its own uncertainty.
-    const GlobalLocalizer::PoseScore sc = omni->score(h.pose, ps, ys, d);
-    return {sc.cost + charge_image(h, sc.missed, sc.unexplained, sc.strays, sc.lamp_costs),
-            contradicts(sc.expected, sc.missing, sc.matched + sc.unexplained, sc.unexplained)};
-  }
-
-  // A lamp in full view the labeller found no map lamp for. Near a map lamp, that lamp is off
-  // by more than the gate: its misfit. Elsewhere, a lamp the map does not have: its spot.
-  double unlabelled(Hypothesis& h, const vision::LampDetection& d) const {
-    const std::optional<Eigen::Vector2d> base = geometry->base_point(d.centre, lamp_height);
-    if (!base) return o.ceiling_spurious_cost;
-    const Eigen::Vector2d at = h.pose.transform_from(*base);
-    const std::vector<const graph::Lamp*> near = map->lamps_within(at, o.stray_radius_m);
-    if (!near.empty())
-      return detail::charge_account(detail::account_of(h.map_costs.misfits, near.front()),
-                                    o.ceiling_spurious_cost, o.lamp_out_cost);
-    return detail::charge_stray(h.map_costs.strays, at, o.stray_radius_m, o.ceiling_spurious_cost,
-                                o.unmapped_lamp_cost);
-  }
-
-  // A ceiling frame for one hypothesis (carried to the frame), updating it.
-  Weighed weigh_ceiling(Hypothesis& h, const std::vector<vision::LampDetection>& lamps) const {
-    std::vector<LabelledLamp> labelled;
-    std::set<LampId> taken;
-    double cost = 0;
-    for (const auto& d : lamps) {
-      if (d.view == vision::LampView::partial) continue;
-      const LabelResult r = labeller->label(d, h.pose, h.covariance, taken);
-      if (r.outcome == LabelOutcome::labelled) {
-        labelled.push_back({r.lamp, d});
-        taken.insert(r.lamp->id);
-      } else if (r.outcome == LabelOutcome::no_candidate) {
-        cost += unlabelled(h, d);
-      }
-    }
-    if (!lamps.empty())  // a dark frame says nothing of missing lamps
-      cost += detail::charge_absences(
-          h.map_costs.lamps,
-          unseen_lamps(*map, *camera, *geometry, *kind, lamps, h.pose, h.covariance),
-          o.ceiling_miss_cost, o.lamp_out_cost);
-    if (!labelled.empty()) {
-      PoseRefusal refusal = PoseRefusal::none;
-      const std::optional<PoseMeasurement> m = measure_pose(
-          *geometry, *camera, labelled, h.pose, Stamp{}, measurement, nullptr, &refusal);
-      // The ceiling camera places a lamp to a few millimetres, so a fit's misfit is mostly the
-      // map's error (a lamp a few centimetres off), the same in every frame: counted, it made
-      // one of two look-alike places certain within a second. Only a misfit past what the map's
-      // errors explain (fit_gate) says the hypothesis is off, charged to the lamps it was fit to.
-      if (m) {
-        const double misfit = update(h, m->pose, m->covariance) + 3.0 - fit_gate;
-        if (misfit > 0) {
-          std::vector<const graph::Lamp*> from;
-          for (const LabelledLamp& l : labelled) from.push_back(l.lamp);
-          cost += detail::charge_fit(h.map_costs.misfits, from, misfit, o.lamp_out_cost);
-        }
-      } else if (refusal == PoseRefusal::labels_disagree)
-        cost += o.ceiling_spurious_cost;
-    }
-    return {cost, false};
-  }
-
   // Carries every hypothesis to `stamp`, kills those that went through a wall, and weighs each
   // with `weigh`; the costs of one frame are taken relative to the best, less `tie`, and capped.
   // Returns whether the frame contradicted every hypothesis. The hypotheses are weighed on every
@@ -289,13 +126,13 @@ struct HypothesisSet::Impl {
       }
       next.push_back(std::move(c));
     }
-    std::vector<Weighed> weighed(next.size());
+    std::vector<detail::Weighed> weighed(next.size());
     // Three or fewer stay on this thread: starting one costs about what weighing one does.
     for_each_costly_index(next.size(), o.weigh_in_parallel ? 3 : next.size(),
                           [&](std::size_t k) { weighed[k] = weigh(next[k]); });
     bool all_contradicted = true;
     double best = std::numeric_limits<double>::infinity();
-    for (const Weighed& w : weighed) {
+    for (const detail::Weighed& w : weighed) {
       all_contradicted = all_contradicted && w.contradicted;
       best = std::min(best, w.cost);
     }
@@ -366,7 +203,7 @@ struct HypothesisSet::Impl {
     h.log_weight = log_weight;
     h.node = p.node;
     // What the image said (births() weighs the newborn with it bounded alike).
-    charge_image(h, p.missed, p.unexplained, p.strays, p.lamp_costs);
+    weigher.charge_image(h, p.missed, p.unexplained, p.strays, p.lamp_costs);
     ++counts.born;
     return h;
   }
@@ -437,7 +274,7 @@ struct HypothesisSet::Impl {
   // image shows what the map lacks.
   bool beyond_map(const PoseHypothesis& h) const {
     return std::any_of(h.strays.begin(), h.strays.end(),
-                       [&](const StraySighting& b) { return beyond_places(b); });
+                       [&](const StraySighting& b) { return weigher.beyond_places(b); });
   }
 
   // Births from one image's enumeration. A complete one starts the set again from every place
@@ -494,8 +331,8 @@ struct HypothesisSet::Impl {
     // explains at most unmapped_lamp_cost, the far ones at most far_stray_cost_max together.
     const auto capped = [&](const PoseHypothesis& h) {
       const auto& q = omni->options().pairs;
-      const int spots = placed_strays(h.strays);  // placed() asks the map: once a stray
-      const double far = far_cost(h.unexplained, spots);
+      const int spots = weigher.placed_strays(h.strays);  // each stray asks the map once
+      const double far = weigher.far_cost(h.unexplained, spots);
       return detail::with_each_bounded(
                  detail::with_each_bounded(h.score, h.missing, q.miss_cost, o.lamp_out_cost), spots,
                  q.spurious_cost, o.unmapped_lamp_cost) -
@@ -659,7 +496,7 @@ void HypothesisSet::omni(Stamp stamp, const vision::OmniDetection& d,
   if (!m.hs.empty()) {
     const bool all_contradicted =
         m.weigh_all(stamp, odometry, m.o.frame_cost_cap, m.o.omni_tie_cost,
-                    [&](Hypothesis& h) { return m.weigh_omni(h, d); });
+                    [&](Hypothesis& h) { return m.weigher.omni(h, d); });
     if (m.complete) ++m.omni_frames;
     m.note_travel(stamp, odometry);
     m.tidy();
@@ -679,9 +516,9 @@ void HypothesisSet::ceiling(Stamp stamp, const std::vector<vision::LampDetection
                             const OdometryTrack& odometry) {
   Impl& m = *impl_;
   // Until the places are all known the omni frames do the weighing (see omni()).
-  if (!m.labeller || m.hs.empty() || !m.complete) return;
+  if (!m.weigher.weighs_ceiling() || m.hs.empty() || !m.complete) return;
   m.weigh_all(stamp, odometry, m.o.ceiling_cost_cap, 0.0,
-              [&](Hypothesis& h) { return m.weigh_ceiling(h, lamps); });
+              [&](Hypothesis& h) { return m.weigher.ceiling(h, lamps); });
   m.note_travel(stamp, odometry);
   m.tidy();
   if (m.complete && m.hs.empty()) m.reset("every hypothesis went through a wall");

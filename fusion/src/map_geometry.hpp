@@ -1,7 +1,7 @@
 #pragma once
 // Two pieces of geometry the hypothesis set uses: whether a rigid motion maps the map onto itself
 // (look-alike places no motion can tell apart), and the Kalman update of a pose hypothesis.
-// Private to hypothesis_set.cpp.
+// Private to the hypothesis set (hypothesis_set.cpp, hypothesis_weighing.cpp).
 
 #include <Eigen/Core>
 #include <Eigen/LU>

@@ -1,0 +1,163 @@
+#include "hypothesis_weighing.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "lampnav/fusion/chi_square.hpp"
+#include "map_evidence.hpp"
+#include "map_geometry.hpp"
+
+namespace lampnav::fusion::detail {
+
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+
+double sigma_position(const Eigen::Matrix3d& P) { return std::sqrt(std::max(P(0, 0), P(1, 1))); }
+
+bool contradicts(int expected, int missing, int seen, int unexplained) {
+  return (expected >= 3 && 2 * missing > expected) || (seen >= 4 && 2 * unexplained > seen);
+}
+
+}  // namespace
+
+HypothesisWeigher::HypothesisWeigher(const graph::TopologicalMap& map,
+                                     const CameraDescription* ceiling_camera,
+                                     const GlobalLocalizer* omni,
+                                     const CeilingPipelineOptions& ceiling_options,
+                                     const HypothesisSetOptions& o)
+    : map_(&map), o_(&o), omni_(omni), measurement_(ceiling_options.measurement) {
+  measurement_.map_sigma = std::max(measurement_.map_sigma, o.map_sigma_m);
+  fit_gate_ = chi_square_quantile(o.fit_gate_probability, 3);
+  if (ceiling_camera) {
+    LabellerOptions lo = ceiling_options.labeller;
+    lo.map_sigma = std::max(lo.map_sigma, o.map_sigma_m);
+    labeller_.emplace(map, *ceiling_camera, lo);
+    geometry_.emplace(*ceiling_camera);
+    camera_.emplace(*ceiling_camera);
+    kind_ = shape_prior_for(map, *ceiling_camera);
+    lamp_height_ = kind_->nominal_distance + ceiling_camera->mount.xyz.z();
+  }
+}
+
+double HypothesisWeigher::update(Hypothesis& h, const Pose2& z, const Eigen::Matrix3d& R) const {
+  return update_pose(h.pose, h.covariance, z, R, o_->sigma_m, o_->sigma_yaw_deg * kDeg);
+}
+
+bool HypothesisWeigher::placed(const StraySighting& b) const {
+  return b.reach <= o_->stray_reach_max_m && (o_->count_beyond_map || !beyond_places(b));
+}
+
+bool HypothesisWeigher::beyond_places(const StraySighting& b) const {
+  return map_->node_near(b.at, b.reach) == nullptr;
+}
+
+int HypothesisWeigher::placed_strays(const std::vector<StraySighting>& strays) const {
+  return static_cast<int>(std::count_if(strays.begin(), strays.end(),
+                                        [&](const StraySighting& b) { return placed(b); }));
+}
+
+double HypothesisWeigher::far_cost(int unexplained, int spots) const {
+  return omni_->options().pairs.spurious_cost * std::max(0, unexplained - spots);
+}
+
+double HypothesisWeigher::charge_image(
+    Hypothesis& h, const std::vector<const graph::Lamp*>& missed, int unexplained,
+    const std::vector<StraySighting>& strays,
+    const std::vector<std::pair<const graph::Lamp*, double>>& lamp_costs) const {
+  const double each = omni_->options().pairs.miss_cost;
+  const double stray = omni_->options().pairs.spurious_cost;
+  double delta = charge_absences(h.map_costs.lamps, missed, each, o_->lamp_out_cost) -
+                 each * static_cast<double>(missed.size());
+  int spots = 0;  // placed() asks the map: once a stray
+  for (const StraySighting& b : strays)
+    if (placed(b)) {
+      ++spots;
+      delta += charge_stray(h.map_costs.strays, b.at, std::max(o_->stray_radius_m, b.reach), stray,
+                            o_->unmapped_lamp_cost) -
+               stray;
+    }
+  const double far = far_cost(unexplained, spots);
+  delta += charge_account(h.map_costs.far_strays, far, o_->far_stray_cost_max) - far;
+  for (const auto& [l, c] : lamp_costs)
+    delta += charge_misfit(h.map_costs.misfits, l, c, o_->lamp_out_cost) - c;
+  return delta;
+}
+
+Weighed HypothesisWeigher::omni(Hypothesis& h, const vision::OmniDetection& d) const {
+  const double ps = std::clamp(sigma_position(h.covariance), 0.03, 1.5);
+  const double ys = std::clamp(std::sqrt(h.covariance(2, 2)), 0.5 * kDeg, 15 * kDeg);
+  const std::optional<PoseHypothesis> r = omni_->refine(h.pose, ps, ys, d);
+  if (r && r->matches.size() >= 2) {
+    Eigen::Matrix3d R = r->covariance;
+    R.diagonal() += Eigen::Vector3d(o_->omni_bump_sigma_m * o_->omni_bump_sigma_m,
+                                    o_->omni_bump_sigma_m * o_->omni_bump_sigma_m,
+                                    std::pow(o_->omni_bump_sigma_deg * kDeg, 2));
+    const int seen = static_cast<int>(r->matches.size()) + r->unexplained;
+    // A misfit better than expected says nothing (map_evidence.hpp, charge_misfit).
+    return {r->score + charge_image(h, r->missed, r->unexplained, r->strays, r->lamp_costs) +
+                std::max(0.0, update(h, r->pose, R)),
+            contradicts(r->expected, r->missing, seen, r->unexplained)};
+  }
+  // Nothing to refine on: the prediction scored as it stands, with its own uncertainty.
+  const GlobalLocalizer::PoseScore sc = omni_->score(h.pose, ps, ys, d);
+  return {sc.cost + charge_image(h, sc.missed, sc.unexplained, sc.strays, sc.lamp_costs),
+          contradicts(sc.expected, sc.missing, sc.matched + sc.unexplained, sc.unexplained)};
+}
+
+double HypothesisWeigher::unlabelled(Hypothesis& h, const vision::LampDetection& d) const {
+  const std::optional<Eigen::Vector2d> base = geometry_->base_point(d.centre, lamp_height_);
+  if (!base) return o_->ceiling_spurious_cost;
+  const Eigen::Vector2d at = h.pose.transform_from(*base);
+  const std::vector<const graph::Lamp*> near = map_->lamps_within(at, o_->stray_radius_m);
+  if (!near.empty())
+    return charge_account(account_of(h.map_costs.misfits, near.front()), o_->ceiling_spurious_cost,
+                          o_->lamp_out_cost);
+  return charge_stray(h.map_costs.strays, at, o_->stray_radius_m, o_->ceiling_spurious_cost,
+                      o_->unmapped_lamp_cost);
+}
+
+Weighed HypothesisWeigher::ceiling(Hypothesis& h,
+                                   const std::vector<vision::LampDetection>& lamps) const {
+  std::vector<LabelledLamp> labelled;
+  std::set<LampId> taken;
+  double cost = 0;
+  for (const auto& d : lamps) {
+    if (d.view == vision::LampView::partial) continue;
+    const LabelResult r = labeller_->label(d, h.pose, h.covariance, taken);
+    if (r.outcome == LabelOutcome::labelled) {
+      labelled.push_back({r.lamp, d});
+      taken.insert(r.lamp->id);
+    } else if (r.outcome == LabelOutcome::no_candidate) {
+      cost += unlabelled(h, d);
+    }
+  }
+  if (!lamps.empty())  // a dark frame says nothing of missing lamps
+    cost += charge_absences(
+        h.map_costs.lamps,
+        unseen_lamps(*map_, *camera_, *geometry_, *kind_, lamps, h.pose, h.covariance),
+        o_->ceiling_miss_cost, o_->lamp_out_cost);
+  if (!labelled.empty()) {
+    PoseRefusal refusal = PoseRefusal::none;
+    const std::optional<PoseMeasurement> m = measure_pose(*geometry_, *camera_, labelled, h.pose,
+                                                          Stamp{}, measurement_, nullptr, &refusal);
+    // The ceiling camera places a lamp to a few millimetres, so a fit's misfit is mostly the
+    // map's error (a lamp a few centimetres off), the same in every frame: counted, it made one
+    // of two look-alike places certain within a second. Only a misfit past what the map's errors
+    // explain (fit_gate_) says the hypothesis is off, charged to the lamps it was fit to.
+    if (m) {
+      const double misfit = update(h, m->pose, m->covariance) + 3.0 - fit_gate_;
+      if (misfit > 0) {
+        std::vector<const graph::Lamp*> from;
+        for (const LabelledLamp& l : labelled) from.push_back(l.lamp);
+        cost += charge_fit(h.map_costs.misfits, from, misfit, o_->lamp_out_cost);
+      }
+    } else if (refusal == PoseRefusal::labels_disagree) {
+      cost += o_->ceiling_spurious_cost;
+    }
+  }
+  return {cost, false};
+}
+
+}  // namespace lampnav::fusion::detail

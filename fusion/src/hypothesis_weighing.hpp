@@ -1,0 +1,85 @@
+#pragma once
+// What one frame says of one pose hypothesis (docs/hypotheses.md): an omni frame's score at the
+// pose least squares refines it to, a ceiling frame's labelled lamps, the lamps either camera
+// missed and the blobs no lamp explains, each charged to the hypothesis's ledgers of what the
+// map may have wrong (map_evidence.hpp), and the Kalman update of the hypothesis by the pose the
+// frame measures. Private to the hypothesis set.
+
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "lampnav/fusion/ceiling_geometry.hpp"
+#include "lampnav/fusion/ceiling_pipeline.hpp"
+#include "lampnav/fusion/global_localizer.hpp"
+#include "lampnav/fusion/hypothesis_set.hpp"
+#include "lampnav/fusion/pose_from_lamps.hpp"
+#include "lampnav/vision/camera_models.hpp"
+
+namespace lampnav::fusion::detail {
+
+// -2 ln L of one frame for one hypothesis, and whether the frame plainly contradicts it (most of
+// the lamps it predicts in clear view unseen, or most of the lamps seen unexplained).
+struct Weighed {
+  double cost = 0;
+  bool contradicted = false;
+};
+
+class HypothesisWeigher {
+ public:
+  // `ceiling_camera` and `omni` may be null: that camera then weighs nothing. `o` is validated
+  // by the caller and must outlive the weigher, as must `map` and `omni`.
+  HypothesisWeigher(const graph::TopologicalMap& map, const CameraDescription* ceiling_camera,
+                    const GlobalLocalizer* omni, const CeilingPipelineOptions& ceiling_options,
+                    const HypothesisSetOptions& o);
+
+  bool weighs_ceiling() const { return labeller_.has_value(); }
+
+  // An omni frame for one hypothesis (carried to the frame), updating it.
+  Weighed omni(Hypothesis& h, const vision::OmniDetection& d) const;
+  // A ceiling frame for one hypothesis (carried to the frame), updating it.
+  Weighed ceiling(Hypothesis& h, const std::vector<vision::LampDetection>& lamps) const;
+
+  // Charges what an omni image said of a hypothesis to its ledgers: the lamps it missed, its
+  // `unexplained` blobs no lamp explains (those placed well enough to a spot, the rest to the
+  // far account), what each lamp's directions cost. Returns what the ledgers charged less what
+  // the image's score counted for them in full.
+  double charge_image(Hypothesis& h, const std::vector<const graph::Lamp*>& missed, int unexplained,
+                      const std::vector<StraySighting>& strays,
+                      const std::vector<std::pair<const graph::Lamp*, double>>& lamp_costs) const;
+  // How many of an image's strays place their lamp well enough to be charged to a spot: near
+  // enough, and within its reach of one of the map's places unless count_beyond_map. (Asked only
+  // of the near ones: a far stray's reach spans many places, and the search through them cost as
+  // much as weighing the hypothesis.)
+  int placed_strays(const std::vector<StraySighting>& strays) const;
+  // Whether a stray's lamp would lie beyond every place of the map (further than its reach).
+  bool beyond_places(const StraySighting& b) const;
+  // What an image's `unexplained` blobs that place no lamp well enough for a spot (all but
+  // `spots` of them) cost in full: the far account's charge before its bound.
+  double far_cost(int unexplained, int spots) const;
+
+ private:
+  bool placed(const StraySighting& b) const;
+  // Kalman update of a hypothesis with a pose measurement (map_geometry.hpp), its covariance no
+  // smaller than odometry between frames allows; returns the normalized innovation squared less
+  // its expectation (3).
+  double update(Hypothesis& h, const Pose2& z, const Eigen::Matrix3d& R) const;
+  // A lamp in full view the labeller found no map lamp for. Near a map lamp, that lamp is off
+  // by more than the gate: its misfit. Elsewhere, a lamp the map does not have: its spot.
+  double unlabelled(Hypothesis& h, const vision::LampDetection& d) const;
+
+  const graph::TopologicalMap* map_;
+  const HypothesisSetOptions* o_;
+  const GlobalLocalizer* omni_;
+  std::optional<LampLabeller> labeller_;
+  std::optional<CeilingGeometry> geometry_;
+  std::optional<vision::PinholeCamera> camera_;
+  std::optional<vision::LampShapePrior> kind_;  // the lamps the ceiling camera looks for
+  PoseMeasurementOptions measurement_;
+  // Where a stray ceiling sighting is placed: the usual height of the lamps the ceiling camera
+  // looks for (their shape prior's nominal distance, above the floor).
+  double lamp_height_ = 0;
+  double fit_gate_ = 0;  // the ceiling fit's normalized innovation the map's errors explain
+};
+
+}  // namespace lampnav::fusion::detail
