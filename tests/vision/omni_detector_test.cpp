@@ -11,28 +11,15 @@
 #include "lampnav/sim/renderers.hpp"
 #include "lampnav/vision/camera_models.hpp"
 #include "lampnav_test.hpp"
+#include "museum.hpp"
 #include "paper_omni_pipeline.hpp"
 
 namespace lampnav::vision {
 namespace {
 
-struct Museum {
-  graph::TopologicalMap map = graph::read_map(test::source_path("maps/domus_museum.geojson")).map;
-  RobotDescription robot = read_robot_description(test::source_path("maps/robots/pioneer.json"));
-  const CameraDescription& cam = *robot.find_camera("omni_camera");
-  std::vector<const graph::Lamp*> lamps() const {
-    std::vector<const graph::Lamp*> out;
-    for (const auto& n : map.nodes())
-      for (const auto& l : n.lamps) out.push_back(&l);
-    return out;
-  }
-  // Every lamp drawn: nobody in the way, no spurious light.
-  sim::OmniRenderer clean_renderer() const {
-    sim::OmniRenderOptions ro;
-    ro.occlusion_probability = 0;
-    ro.spurious_per_image = 0;
-    return sim::OmniRenderer(cam, ro);
-  }
+struct Museum : test::Museum {
+  const CameraDescription& cam = omni_camera();
+  sim::OmniRenderer clean_renderer() const { return test::clean_omni_renderer(cam); }
   // `n` clean views from random poses in halls E and A.
   std::vector<std::pair<Pose2, Image8>> random_views(std::uint64_t seed, int n) const {
     const sim::OmniRenderer renderer = clean_renderer();
