@@ -3,15 +3,26 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 namespace lampnav::fusion::detail {
 
 namespace {
 constexpr double kDeg = M_PI / 180.0;
+// The position and heading sigmas both places of a comparison are scored with: the estimate's.
+std::pair<double, double> sigmas(const FilterState& prior) {
+  return {std::clamp(std::sqrt(std::max(prior.P(0, 0), prior.P(1, 1))), 0.05, 0.5),
+          std::clamp(std::sqrt(prior.P(2, 2)), 0.5 * kDeg, 5 * kDeg)};
+}
+
 }  // namespace
 
-Auditor::Auditor(const GlobalLocalizer& global, const LocalizerOptions& o)
+Auditor::Auditor(const graph::TopologicalMap& map, const GlobalLocalizer& global,
+                 const LocalizerOptions& o)
     : global_(&global),
+      look_alikes_(o.audit_period > Duration::zero()
+                       ? look_alike_motions(map, o.audit_look_alike_fraction, o.audit_look_alikes)
+                       : std::vector<LookAlikeMotion>{}),
       period_(o.audit_period),
       second_opinion_ratio_(o.second_opinion_ratio),
       distance_m_(o.second_opinion_distance),
@@ -32,10 +43,34 @@ std::optional<Elsewhere> Auditor::elsewhere(const FilterState& prior,
   return compared(prior, far->pose, omni);
 }
 
+std::optional<Elsewhere> Auditor::likeliest_look_alike(const FilterState& prior,
+                                                       const vision::OmniDetection& omni) const {
+  // A carry the ceiling camera cannot see leaves the robot where the estimate's look-alike
+  // stands, to the estimate's own error: each is scored where the motion puts it, and only the
+  // likeliest, when likelier than the estimate, is refined on the frame.
+  if (look_alikes_.empty()) return std::nullopt;
+  const auto [sp, sy] = sigmas(prior);
+  const double here_cost = global_->score(prior.pose(), sp, sy, omni).cost;
+  std::optional<Pose2> best;
+  double best_cost = here_cost;
+  for (const LookAlikeMotion& m : look_alikes_) {
+    const Pose2 there = m.motion * prior.pose();
+    if ((there.translation() - prior.pose().translation()).norm() < distance_m_) continue;
+    const double cost = global_->score(there, sp, sy, omni).cost;
+    if (cost < best_cost) best_cost = cost, best = there;
+  }
+  if (!best) return std::nullopt;
+  Elsewhere e = compared(prior, *best, omni);
+  if (const std::optional<PoseHypothesis> refined = global_->refine(*best, 0.3, 3 * kDeg, omni)) {
+    const Elsewhere r = compared(prior, refined->pose, omni);
+    if (r.away >= distance_m_ && r.log_ratio > e.log_ratio) e = r;
+  }
+  return e;
+}
+
 Elsewhere Auditor::compared(const FilterState& prior, const Pose2& there,
                             const vision::OmniDetection& omni) const {
-  const double sp = std::clamp(std::sqrt(std::max(prior.P(0, 0), prior.P(1, 1))), 0.05, 0.5);
-  const double sy = std::clamp(std::sqrt(prior.P(2, 2)), 0.5 * kDeg, 5 * kDeg);
+  const auto [sp, sy] = sigmas(prior);
   const double here_cost = global_->score(prior.pose(), sp, sy, omni).cost;
   const double there_cost = global_->score(there, sp, sy, omni).cost;
   return Elsewhere{there, (there.translation() - prior.pose().translation()).norm(),
@@ -75,7 +110,9 @@ std::optional<LossVerdict> Auditor::audit(Stamp stamp, const FilterState& prior,
                                           const vision::OmniDetection& omni,
                                           const OdometryTrack& odometry) {
   if (challenger_) return challenge(stamp, prior, r, omni, odometry);
-  const std::optional<Elsewhere> e = elsewhere(prior, omni, false);
+  std::optional<Elsewhere> e = elsewhere(prior, omni, false);
+  if (const std::optional<Elsewhere> twin = likeliest_look_alike(prior, omni))
+    if (!e || twin->log_ratio > e->log_ratio) e = twin;
   if (!e || e->log_ratio < std::log(step_ratio_)) return std::nullopt;
   if (e->log_ratio >= std::log(ratio_)) return loss(*e, e->log_ratio, 1, r);
   if (odometry.empty()) return std::nullopt;

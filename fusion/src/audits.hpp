@@ -5,6 +5,7 @@
 // (docs/localization.md, "Audits" and "Audits that add up"). Private to the localizer.
 
 #include <optional>
+#include <vector>
 
 #include "lampnav/core/pose2.hpp"
 #include "lampnav/core/time.hpp"
@@ -13,6 +14,7 @@
 #include "lampnav/fusion/kidnap_monitor.hpp"
 #include "lampnav/fusion/localizer.hpp"
 #include "lampnav/fusion/odometry_track.hpp"
+#include "look_alikes.hpp"
 
 namespace lampnav::fusion::detail {
 
@@ -28,8 +30,10 @@ struct Elsewhere {
 class Auditor {
  public:
   // Reads the second-opinion and audit options of `o` (validated by LocalizerOptions), and
-  // HypothesisSetOptions::station_m: one spot's images repeat one image's evidence.
-  Auditor(const GlobalLocalizer& global, const LocalizerOptions& o);
+  // HypothesisSetOptions::station_m: one spot's images repeat one image's evidence. Finds the
+  // map's look-alike motions (look_alikes.hpp) once.
+  Auditor(const graph::TopologicalMap& map, const GlobalLocalizer& global,
+          const LocalizerOptions& o);
 
   // An omni check disagreed with the estimate: does the frame itself put the robot farther than
   // second_opinion_distance away, second_opinion_ratio likelier? Asked only of a search that
@@ -70,6 +74,11 @@ class Auditor {
   // with that place.
   std::optional<Elsewhere> elsewhere(const FilterState& prior, const vision::OmniDetection& omni,
                                      bool named) const;
+  // The likeliest of the places the map's look-alike motions carry the estimate to, more than
+  // second_opinion_distance away, each refined on the frame: the places a carry the ceiling
+  // camera cannot see puts the robot, weighed whether or not the search finds them.
+  std::optional<Elsewhere> likeliest_look_alike(const FilterState& prior,
+                                                const vision::OmniDetection& omni) const;
   Elsewhere compared(const FilterState& prior, const Pose2& there,
                      const vision::OmniDetection& omni) const;
   std::optional<LossVerdict> challenge(Stamp stamp, const FilterState& prior,
@@ -78,6 +87,7 @@ class Auditor {
   static LossVerdict loss(const Elsewhere& e, double log_sum, int images, const OmniCheckResult& r);
 
   const GlobalLocalizer* global_;
+  std::vector<LookAlikeMotion> look_alikes_;
   Duration period_;
   double second_opinion_ratio_, distance_m_, ratio_, step_ratio_, station_m_;
   int challenge_frames_;

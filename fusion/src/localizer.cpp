@@ -35,6 +35,11 @@ void LocalizerOptions::validate() const {
   if (!(audit_ratio >= 1 && std::isfinite(audit_ratio)))
     throw InputError({"", "localizer options", "audit_ratio"},
                      "must be a likelihood ratio of at least 1");
+  if (audit_look_alikes < 0 || audit_look_alikes > 1000)
+    throw InputError({"", "localizer options", "audit_look_alikes"}, "must be 0 to 1000");
+  if (!(audit_look_alike_fraction > 0 && audit_look_alike_fraction <= 1))
+    throw InputError({"", "localizer options", "audit_look_alike_fraction"},
+                     "must be a fraction of the lamps, above 0 and at most 1");
   if (audit_challenge_frames < 1)
     throw InputError({"", "localizer options", "audit_challenge_frames"}, "must be at least 1");
   if (!(audit_step_ratio >= 1 && audit_step_ratio <= audit_ratio))
@@ -116,7 +121,7 @@ struct Localizer::Impl {
       omni_detector.emplace(*c, o.omni_detector);
       omni_check.emplace(m, *c, o.omni_check);
       global.emplace(m, *c, o.global);
-      auditor.emplace(*global, o);
+      auditor.emplace(m, *global, o);
     }
     hypotheses.emplace(m, ceiling_camera, global ? &*global : nullptr, o.ceiling, o.hypotheses);
   }

@@ -1,7 +1,7 @@
 #pragma once
-// Two pieces of geometry the hypothesis set uses: whether a rigid motion maps the map onto itself
-// (look-alike places no motion can tell apart), and the Kalman update of a pose hypothesis.
-// Private to the hypothesis set (hypothesis_set.cpp, hypothesis_weighing.cpp).
+// Geometry of the map and of pose hypotheses: whether a rigid motion carries a lamp, or the whole
+// map, onto lamps alike (look-alike places), and the Kalman update of a pose hypothesis. Private
+// to fusion (the hypothesis set, the audits).
 
 #include <Eigen/Core>
 #include <Eigen/LU>
@@ -12,28 +12,33 @@
 
 namespace lampnav::fusion::detail {
 
-// Whether the rigid motion T maps every lamp of the map onto a lamp of the same shape and size
-// (within 0.15 m, 5 cm of size and height; a rectangle's axis within 3 degrees, modulo a half
-// turn).
-inline bool maps_onto_itself(const graph::TopologicalMap& map, const Pose2& T) {
+// Whether lamp m is of the same shape and size as lamp l, at the same height (within 5 cm).
+inline bool alike(const graph::Lamp& m, const graph::Lamp& l) {
+  return m.shape == l.shape && std::abs(m.length - l.length) <= 0.05 &&
+         std::abs(m.width - l.width) <= 0.05 && std::abs(m.xyz.z() - l.xyz.z()) <= 0.05;
+}
+
+// Whether lamp m is alike to lamp l turned by `yaw`: a rectangle's axis within 3 degrees of l's
+// turned, modulo a half turn.
+inline bool alike_turned(const graph::Lamp& m, const graph::Lamp& l, double yaw) {
   constexpr double kDeg = M_PI / 180.0;
-  const double c = std::cos(T.yaw()), s = std::sin(T.yaw());
-  for (const auto& n : map.nodes()) {
-    for (const auto& l : n.lamps) {
-      const Eigen::Vector2d p = T.translation() + Eigen::Vector2d(c * l.xyz.x() - s * l.xyz.y(),
-                                                                  s * l.xyz.x() + c * l.xyz.y());
-      bool found = false;
-      for (const graph::Lamp* m : map.lamps_within(p, 0.15)) {
-        if (m->shape != l.shape || std::abs(m->length - l.length) > 0.05 ||
-            std::abs(m->width - l.width) > 0.05 || std::abs(m->xyz.z() - l.xyz.z()) > 0.05)
-          continue;
-        const bool round = l.shape == graph::LampShape::disc || l.length <= l.width;
-        const double d = wrap_angle(m->yaw - (l.yaw + T.yaw()));
-        if (round || std::abs(std::sin(d)) < std::sin(3 * kDeg)) found = true;
-      }
-      if (!found) return false;
-    }
-  }
+  if (!alike(m, l)) return false;
+  const bool round = l.shape == graph::LampShape::disc || l.length <= l.width;
+  return round || std::abs(std::sin(wrap_angle(m.yaw - (l.yaw + yaw)))) < std::sin(3 * kDeg);
+}
+
+// Whether the rigid motion T carries lamp `l` within 0.15 m of a lamp alike to it turned.
+inline bool lands_on_alike(const graph::TopologicalMap& map, const Pose2& T, const graph::Lamp& l) {
+  for (const graph::Lamp* m : map.lamps_within(T.transform_from(l.xyz.head<2>()), 0.15))
+    if (alike_turned(*m, l, T.yaw())) return true;
+  return false;
+}
+
+// Whether the rigid motion T maps every lamp of the map onto a lamp alike (lands_on_alike).
+inline bool maps_onto_itself(const graph::TopologicalMap& map, const Pose2& T) {
+  for (const auto& n : map.nodes())
+    for (const auto& l : n.lamps)
+      if (!lands_on_alike(map, T, l)) return false;
   return true;
 }
 

@@ -591,6 +591,11 @@ TEST(Localizer, AuditsRunOnScheduleOnceThePoseIsOut) {
   refused([](LocalizerOptions& o) { o.audit_ratio = 0.5; }, "audit_ratio");
   refused([](LocalizerOptions& o) { o.audit_step_ratio = 2 * o.audit_ratio; }, "audit_step_ratio");
   refused([](LocalizerOptions& o) { o.audit_challenge_frames = 0; }, "audit_challenge_frames");
+  refused([](LocalizerOptions& o) { o.audit_look_alikes = -1; }, "audit_look_alikes");
+  refused([](LocalizerOptions& o) { o.audit_look_alike_fraction = 0; },
+          "audit_look_alike_fraction");
+  refused([](LocalizerOptions& o) { o.audit_look_alike_fraction = 1.5; },
+          "audit_look_alike_fraction");
   refused([](LocalizerOptions& o) { o.hypotheses.partial_view_travel_m = -1; },
           "partial_view_travel_m");
 }

@@ -84,8 +84,8 @@ struct LocalizerOptions {
   // search of a regular ceiling is cut short (look-alike places tie near the zenith) and finds
   // the true place in some images only. Carries into the office's twin corridors went unnoticed
   // for 1.1 to 81 s with audits every 5 s that did not add up, 1.1 to 21.5 s every 2 s adding up,
-  // 1.1 to 17.5 s every 1 s (16 drives carried twice, docs/localization.md, "Audits that add
-  // up").
+  // 1.1 to 17.5 s every 1 s, 1.1 to 6.5 s every 2 s weighing the building's own look-alikes too
+  // (16 drives carried twice, docs/localization.md, "Audits that add up").
   Duration audit_period = std::chrono::seconds(2);
   // The likelihood ratio an audit needs, far above the second opinion's: nothing local doubts
   // the estimate then. Measured: places likelier than a right estimate by at most e^10.4 (a map
@@ -102,6 +102,14 @@ struct LocalizerOptions {
   // e^6.9, publish_ratio's figure.
   double audit_step_ratio = 1000;
   int audit_challenge_frames = 10;
+  // Each audit also weighs the places the building's own look-alikes carry the estimate to: the
+  // rigid motions of the map that carry at least audit_look_alike_fraction of its lamps onto
+  // lamps alike (a regular office's half turn, slides along its rows of lamps), at most
+  // audit_look_alikes of them, each place refined on the frame (docs/localization.md, "The
+  // building's own look-alikes"). The search alone often misses them: it is cut short where
+  // look-alike places tie. 0 off.
+  int audit_look_alikes = 24;
+  double audit_look_alike_fraction = 0.5;
   // Wheel readings further apart than this (odometry that stopped and came back, a clock that
   // jumped) leave the motion in between unknown: the estimate is no longer certain, and the
   // localizer looks for the robot again (keeping the estimate as one of the places it may be).
