@@ -9,6 +9,7 @@ namespace lampnav::fusion::detail {
 
 namespace {
 constexpr double kDeg = M_PI / 180.0;
+constexpr int kLookAlikeMatches = 3;  // blobs a look-alike place must explain to challenge
 // The position and heading sigmas both places of a comparison are scored with: the estimate's.
 std::pair<double, double> sigmas(const FilterState& prior) {
   return {std::clamp(std::sqrt(std::max(prior.P(0, 0), prior.P(1, 1))), 0.05, 0.5),
@@ -50,14 +51,18 @@ std::optional<Elsewhere> Auditor::likeliest_look_alike(const FilterState& prior,
   // likeliest, when likelier than the estimate, is refined on the frame.
   if (look_alikes_.empty()) return std::nullopt;
   const auto [sp, sy] = sigmas(prior);
-  const double here_cost = global_->score(prior.pose(), sp, sy, omni).cost;
+  const GlobalLocalizer::PoseScore here = global_->score(prior.pose(), sp, sy, omni);
+  // Only a place that explains at least as many of the frame's blobs as the estimate (and three
+  // or more) may challenge it: what the frame shows, not only the lamps it misses. A dark or
+  // empty frame misses fewer lamps where fewer are in view, and says nothing of where the robot is.
+  const int needed = std::max(kLookAlikeMatches, here.matched);
   std::optional<Pose2> best;
-  double best_cost = here_cost;
+  double best_cost = here.cost;
   for (const LookAlikeMotion& m : look_alikes_) {
     const Pose2 there = m.motion * prior.pose();
     if ((there.translation() - prior.pose().translation()).norm() < distance_m_) continue;
-    const double cost = global_->score(there, sp, sy, omni).cost;
-    if (cost < best_cost) best_cost = cost, best = there;
+    const GlobalLocalizer::PoseScore sc = global_->score(there, sp, sy, omni);
+    if (sc.matched >= needed && sc.cost < best_cost) best_cost = sc.cost, best = there;
   }
   if (!best) return std::nullopt;
   Elsewhere e = compared(prior, *best, omni);
