@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
@@ -395,6 +396,11 @@ Stamp stamp(const Json& j) {
     throw BadMessage("timestamp sec/nsec must be integers");
   const std::int64_t nsec = n.get<std::int64_t>();
   if (nsec < 0 || nsec >= 1'000'000'000) throw BadMessage("timestamp nsec must be in [0, 1e9)");
+  // Nanoseconds since 1970 in 64 bits reach the year 2262: seconds beyond would wrap.
+  constexpr std::int64_t kMaxSec = std::numeric_limits<std::int64_t>::max() / 1'000'000'000 - 1;
+  if (s.is_number_unsigned() ? s.get<std::uint64_t>() > std::uint64_t(kMaxSec)
+                             : s.get<std::int64_t>() > kMaxSec || s.get<std::int64_t>() < -kMaxSec)
+    throw BadMessage("timestamp sec is out of range (more than 292 years from 1970)");
   return stamp_from_nanoseconds(s.get<std::int64_t>() * 1'000'000'000 + nsec);
 }
 ImageFrame image(const Json& j) {
@@ -426,7 +432,8 @@ void decode_json(const McapChannel& ch, const McapMessage& m, DecodedMessage& d)
     Json j;
     try {
       j = Json::parse(m.data);
-    } catch (const Json::parse_error& e) {
+    } catch (const Json::exception& e) {
+      // A syntax error, or a number past a double's range ("4E1000000": out_of_range.406).
       throw BadMessage(std::string("bad JSON: ") + e.what());
     }
     if (!j.is_object()) throw BadMessage("not a JSON object");
