@@ -2,7 +2,8 @@
 // The omnidirectional view's own answer to "is the robot where the estimate says?" while the
 // estimate is certain: second opinions when an omni check disagrees, and audits on schedule
 // whatever the checks say, whose evidence adds up over the frames that follow
-// (docs/localization.md, "Audits" and "Audits that add up"). Private to the localizer.
+// (docs/localization.md, "Audits", "Audits that add up" and "The building's own look-alikes").
+// Private to the localizer.
 
 #include <optional>
 #include <vector>
@@ -75,8 +76,9 @@ class Auditor {
   std::optional<Elsewhere> elsewhere(const FilterState& prior, const vision::OmniDetection& omni,
                                      bool named) const;
   // The likeliest of the places the map's look-alike motions carry the estimate to, more than
-  // second_opinion_distance away, each refined on the frame: the places a carry the ceiling
-  // camera cannot see puts the robot, weighed whether or not the search finds them.
+  // second_opinion_distance away and explaining as many of the frame's blobs as the estimate
+  // (three or more), refined on the frame: the places a carry the ceiling camera cannot see puts
+  // the robot, weighed whether or not the search finds them.
   std::optional<Elsewhere> likeliest_look_alike(const FilterState& prior,
                                                 const vision::OmniDetection& omni) const;
   Elsewhere compared(const FilterState& prior, const Pose2& there,
