@@ -10,13 +10,12 @@ namespace lampnav::fusion::detail {
 namespace {
 constexpr double kDeg = M_PI / 180.0;
 constexpr int kLookAlikeMatches = 3;  // blobs a look-alike place must explain to challenge
-// The position and heading sigmas both places of a comparison are scored with: the estimate's.
-std::pair<double, double> sigmas(const FilterState& prior) {
+}  // namespace
+
+EstimateSigmas estimate_sigmas(const FilterState& prior) {
   return {std::clamp(std::sqrt(std::max(prior.P(0, 0), prior.P(1, 1))), 0.05, 0.5),
           std::clamp(std::sqrt(prior.P(2, 2)), 0.5 * kDeg, 5 * kDeg)};
 }
-
-}  // namespace
 
 Auditor::Auditor(const graph::TopologicalMap& map, const GlobalLocalizer& global,
                  const LocalizerOptions& o)
@@ -50,7 +49,7 @@ std::optional<Elsewhere> Auditor::likeliest_look_alike(const FilterState& prior,
   // stands, to the estimate's own error: each is scored where the motion puts it, and only the
   // likeliest, when likelier than the estimate, is refined on the frame.
   if (look_alikes_.empty()) return std::nullopt;
-  const auto [sp, sy] = sigmas(prior);
+  const auto [sp, sy] = estimate_sigmas(prior);
   const GlobalLocalizer::PoseScore here = global_->score(prior.pose(), sp, sy, omni);
   // Only a place that explains at least as many of the frame's blobs as the estimate (and three
   // or more) may challenge it: what the frame shows, not only the lamps it misses. A dark or
@@ -75,7 +74,7 @@ std::optional<Elsewhere> Auditor::likeliest_look_alike(const FilterState& prior,
 
 Elsewhere Auditor::compared(const FilterState& prior, const Pose2& there,
                             const vision::OmniDetection& omni) const {
-  const auto [sp, sy] = sigmas(prior);
+  const auto [sp, sy] = estimate_sigmas(prior);
   const double here_cost = global_->score(prior.pose(), sp, sy, omni).cost;
   const double there_cost = global_->score(there, sp, sy, omni).cost;
   return Elsewhere{there, (there.translation() - prior.pose().translation()).norm(),

@@ -22,6 +22,14 @@ namespace lampnav::fusion::detail {
 // A place an omni frame's search finds away from the estimate, weighed against it on that
 // frame. Both poses are scored alike (the estimate's uncertainty for both), so the ratio
 // compares the places, not their refinement.
+// The position and heading sigmas an estimate's omni image is refined and scored with: the
+// filter's own, held to what one omni image can tell apart (5 cm to 0.5 m, 0.5 to 5 degrees).
+struct EstimateSigmas {
+  double position_m = 0;
+  double yaw_rad = 0;
+};
+EstimateSigmas estimate_sigmas(const FilterState& prior);
+
 struct Elsewhere {
   Pose2 pose;
   double away = 0;       // m from the estimate

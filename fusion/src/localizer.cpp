@@ -255,9 +255,9 @@ struct Localizer::Impl {
   // that the filter's gate refuses is not taken as evidence of a kidnap (its matches are the
   // doubtful part).
   void omni_update(Stamp stamp, const FilterState& prior, bool checked) {
-    const double sp = std::clamp(std::sqrt(std::max(prior.P(0, 0), prior.P(1, 1))), 0.05, 0.5);
-    const double sy = std::clamp(std::sqrt(prior.P(2, 2)), 0.5 * kDeg, 5 * kDeg);
-    const std::optional<PoseHypothesis> h = global->refine(prior.pose(), sp, sy, last_omni);
+    const detail::EstimateSigmas s = detail::estimate_sigmas(prior);
+    const std::optional<PoseHypothesis> h =
+        global->refine(prior.pose(), s.position_m, s.yaw_rad, last_omni);
     if (!h || int(h->matches.size()) < o.omni_update_min_lamps || h->missing > h->expected / 2)
       return;
     // The least-squares covariance knows detection noise only; floor bumps add to it.
