@@ -111,9 +111,10 @@ struct HypothesisSet::Impl {
 
   // Carries every hypothesis to `stamp`, kills those that went through a wall, and weighs each
   // with `weigh`; the costs of one frame are taken relative to the best, less `tie`, and capped.
-  // Returns whether the frame contradicted every hypothesis. The hypotheses are weighed on every
-  // core (each alone, so the result does not depend on how many): a frame with a hundred of them is
-  // a few milliseconds of work.
+  // Returns whether the frame contradicted every hypothesis (never, for a frame that does not
+  // judge that: the hypotheses then keep what the last frame that judged said of each). The
+  // hypotheses are weighed on every core (each alone, so the result does not depend on how many): a
+  // frame with a hundred of them is a few milliseconds of work.
   template <class Weigh>
   bool weigh_all(Stamp stamp, const OdometryTrack& odo, double cap, double tie, Weigh weigh) {
     std::vector<Hypothesis> next;
@@ -133,12 +134,12 @@ struct HypothesisSet::Impl {
     bool all_contradicted = true;
     double best = std::numeric_limits<double>::infinity();
     for (const detail::Weighed& w : weighed) {
-      all_contradicted = all_contradicted && w.contradicted;
+      all_contradicted = all_contradicted && w.contradicted.value_or(false);
       best = std::min(best, w.cost);
     }
     for (std::size_t k = 0; k < next.size(); ++k) {
       next[k].last_cost = weighed[k].cost;
-      next[k].contradicted = weighed[k].contradicted;
+      if (weighed[k].contradicted) next[k].contradicted = *weighed[k].contradicted;
       next[k].log_weight -= 0.5 * std::min(cap, std::max(0.0, weighed[k].cost - best - tie));
       next[k].node = map->node_containing(next[k].pose.translation());
     }
@@ -468,6 +469,7 @@ void HypothesisSet::keep(Stamp stamp, const Pose2& pose, const Eigen::Matrix3d& 
   Hypothesis h;
   h.id = m.next_id++;
   h.origin = HypothesisOrigin::kept;
+  h.ceiling_fitted = true;
   h.stamp = stamp;
   h.pose = pose;
   h.covariance = covariance;

@@ -59,6 +59,8 @@ void HypothesisSetOptions::validate() const {
         "must not be negative");
   check(ceiling_miss_cost >= 0 && ceiling_spurious_cost >= 0, "ceiling_miss_cost",
         "must not be negative");
+  check(ceiling_label_sigma_m >= 0 && std::isfinite(ceiling_label_sigma_m), "ceiling_label_sigma_m",
+        "must be finite and not negative");
   check(lamp_out_cost >= 0, "lamp_out_cost", "must not be negative");
   check(unmapped_lamp_cost >= 0, "unmapped_lamp_cost", "must not be negative");
   check(stray_radius_m > 0, "stray_radius_m", "must be positive");

@@ -122,10 +122,15 @@ Weighed HypothesisWeigher::ceiling(Hypothesis& h,
                                    const std::vector<vision::LampDetection>& lamps) const {
   std::vector<LabelledLamp> labelled;
   std::set<LampId> taken;
+  Eigen::Matrix3d label_covariance = h.covariance;
+  if (!h.ceiling_fitted) {
+    const double floor = o_->ceiling_label_sigma_m * o_->ceiling_label_sigma_m;
+    for (int k = 0; k < 2; ++k) label_covariance(k, k) = std::max(label_covariance(k, k), floor);
+  }
   double cost = 0;
   for (const auto& d : lamps) {
     if (d.view == vision::LampView::partial) continue;
-    const LabelResult r = labeller_->label(d, h.pose, h.covariance, taken);
+    const LabelResult r = labeller_->label(d, h.pose, label_covariance, taken);
     if (r.outcome == LabelOutcome::labelled) {
       labelled.push_back({r.lamp, d});
       taken.insert(r.lamp->id);
@@ -147,6 +152,7 @@ Weighed HypothesisWeigher::ceiling(Hypothesis& h,
     // of two look-alike places certain within a second. Only a misfit past what the map's errors
     // explain (fit_gate_) says the hypothesis is off, charged to the lamps it was fit to.
     if (m) {
+      h.ceiling_fitted = true;
       const double misfit = update(h, m->pose, m->covariance) + 3.0 - fit_gate_;
       if (misfit > 0) {
         std::vector<const graph::Lamp*> from;
@@ -157,7 +163,7 @@ Weighed HypothesisWeigher::ceiling(Hypothesis& h,
       cost += o_->ceiling_spurious_cost;
     }
   }
-  return {cost, false};
+  return {cost, std::nullopt};
 }
 
 }  // namespace lampnav::fusion::detail

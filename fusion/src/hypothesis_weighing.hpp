@@ -19,10 +19,12 @@
 namespace lampnav::fusion::detail {
 
 // -2 ln L of one frame for one hypothesis, and whether the frame plainly contradicts it (most of
-// the lamps it predicts in clear view unseen, or most of the lamps seen unexplained).
+// the lamps it predicts in clear view unseen, or most of the lamps seen unexplained). Only an omni
+// frame sees enough of the ceiling to judge that; a ceiling frame leaves it unjudged, and the
+// hypothesis keeps what the last omni frame said of it.
 struct Weighed {
   double cost = 0;
-  bool contradicted = false;
+  std::optional<bool> contradicted;
 };
 
 class HypothesisWeigher {

@@ -1,0 +1,105 @@
+// Regular generated buildings with lamps failed (lit in the map, dark in the building), floors
+// that swing the cameras and robots carried twice, replayed without their start: the drives of a
+// sweep of 24 (docs/hypotheses.md, "Failed lamps and carries") that published a wrong pose as
+// certain before the changes these tests keep.
+
+#include <cmath>
+#include <functional>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "lampnav/evaluation/replay.hpp"
+#include "lampnav/graph/geojson.hpp"
+#include "lampnav/io/mission_log.hpp"
+#include "lampnav/sim/building.hpp"
+#include "lampnav/sim/scenario.hpp"
+#include "lampnav_test.hpp"
+#include "recorded_drive.hpp"
+
+namespace lampnav {
+namespace {
+
+// A generated grid: about `nodes` nodes, junctions `block_m` apart, lamps `spacing_m` apart
+// `ceiling_m` up, rooms (sim::BuildingOptions for the rest).
+sim::BuildingOptions grid(int nodes, double block_m, double spacing_m, double ceiling_m,
+                          std::uint64_t seed) {
+  sim::BuildingOptions b;
+  b.nodes = nodes;
+  b.block_m = block_m;
+  b.lamp_spacing_m = spacing_m;
+  b.ceiling_m = ceiling_m;
+  b.seed = seed;
+  return b;
+}
+
+// `lampnav sim --map B --route 'FROM -> TO' --seed S --kidnap 25 --kidnap 60 --fail-lamp ...
+// --bumps 1.0` on the building, with what `more` changes, replayed without its start.
+evaluation::Metrics replayed(const sim::BuildingOptions& building, const std::string& from,
+                             const std::string& to, std::uint64_t seed,
+                             const std::vector<std::string>& failed, const std::string& log_name,
+                             const std::function<void(sim::Scenario&)>& more) {
+  const std::string geojson = sim::generate_building(building).geojson;
+  const graph::TopologicalMap map = graph::parse_map(geojson, "generated.geojson").map;
+  const RobotDescription robot =
+      read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  sim::Scenario s = sim::make_route_scenario(map, geojson, robot, from, to, seed);
+  s.kidnaps = {{25, std::nullopt}, {60, std::nullopt}};
+  s.failed_lamps.insert(failed.begin(), failed.end());
+  s.bump_sigma_rad = 1.0 * M_PI / 180;
+  more(s);
+  const io::MissionLog log = test::recorded_drive(s, log_name);
+
+  const evaluation::ReplayResult r = evaluation::replay(log, map, robot);
+  for (const auto& e : r.events)
+    std::cout << to_seconds(e.stamp) << " s: " << fusion::to_string(e.mode) << ", " << e.reason
+              << "\n";
+  return evaluation::score(r, log);
+}
+
+// A 3 x 3 grid of junctions 12 m apart, lamps 2 m apart 2.5 m up, a lobby, two corridors missing.
+// Carried at 25 s, the robot was not found again by 60 s; its set's leader, the place it stood
+// at 60 s, was carried away with it. The first omni image after the carry contradicted the
+// leader (9.2, the cap), and every hypothesis but one far behind; the ceiling frame captured
+// before that image, weighed after it (the ceiling camera's frames come a second late), said
+// nothing and cleared the contradiction, and the leader, 4.9 m off, was published at once (for
+// 2.7 s). Only an omni image judges a contradiction now; the next one must clear it.
+TEST(FailedLampsAndCarries, AContradictionHoldsUntilTheNextOmniImage) {
+  sim::BuildingOptions b = grid(25, 12, 2.0, 2.5, 72);
+  b.rooms = false;
+  b.missing_corridors = 2;
+  b.lobby = true;
+  const evaluation::Metrics m =
+      replayed(b, "J0_1", "J2_1", 81, {"V2_1-L5", "V1_0-L4", "H0_1-L4", "H1_2-L5"},
+               "failed_lamps_contradiction.mcap",
+               [](sim::Scenario& s) { s.max_duration_s = 66; });  // published at 61.6 s
+  ASSERT_EQ(m.kidnaps, 2);
+  EXPECT_EQ(m.wrong_fixes, 0);
+}
+
+// A 4 x 4 grid of junctions 15 m apart, lamps 2.5 m apart 3 m up (3 m apart east of the middle),
+// rooms; the floor swings the cameras 1.5 degrees and the wheels read 1.2 % long and 0.9 % short.
+// After the second carry an audit found the robot gone, and one omni image gave nine places.
+// The truth was born 30 cm to the side of its corridor's axis, its position sigma 12 cm, and the
+// lamps its ceiling camera saw overhead fell outside its gate: each was charged as a lamp the map
+// lacks, frame after frame. Its quarter-turn twin 35 m away, born off along its corridor, took
+// its lamps and was pulled onto them; two seconds later the twin was published. Until a
+// hypothesis is fitted to ceiling lamps, its lamps are now labelled with at least the position
+// uncertainty an omni image leaves (20 cm).
+TEST(FailedLampsAndCarries, ARightPlaceBornBesideItsLampsLabelsThem) {
+  sim::BuildingOptions b = grid(40, 15, 2.5, 3.0, 71);
+  b.wing_lamp_spacing_m = 3.0;
+  const evaluation::Metrics m =
+      replayed(b, "J3_0", "J0_3", 82, {"V1_2-L3", "V1_0-L2", "H0_2-L4", "V0_0-L3"},
+               "failed_lamps_born_beside.mcap", [](sim::Scenario& s) {
+                 s.bump_sigma_rad = 1.5 * M_PI / 180;
+                 s.odometry.left_scale = 0.012;
+                 s.odometry.right_scale = -0.009;
+                 s.max_duration_s = 70;  // the twin was published at 65.5 s
+               });
+  ASSERT_EQ(m.kidnaps, 2);
+  EXPECT_EQ(m.wrong_fixes, 0);
+}
+
+}  // namespace
+}  // namespace lampnav
