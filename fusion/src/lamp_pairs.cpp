@@ -363,11 +363,15 @@ GlobalLocalization GlobalLocalizer::Impl::exhaustive(const vision::OmniDetection
       refined.begin(), refined.end(),
       [](const PoseHypothesis& a, const PoseHypothesis& b) { return a.score < b.score; });
   if (!refined.empty()) {
-    // The best first: the others are judged against its refined score.
+    // Which are plausible is judged on the one round all of them had: against the best's full
+    // refinement, exact twins of it (a regular building's turned places, tied after one round)
+    // were left at their one-round score, 35 behind, and one image made the first of them, by
+    // the order of its cell, the only place (docs/hypotheses.md, "Twins left unrefined").
+    const double one_round_best = refined.front().score;
     refined.front() = refine(refined.front().pose, 0.1, 1 * kDeg, blobs);
     std::size_t plausible = 1;
     while (plausible < refined.size() && plausible < 32 &&
-           !(refined[plausible].score > refined.front().score + q.ambiguity_margin))
+           !(refined[plausible].score > one_round_best + q.ambiguity_margin))
       ++plausible;
     for_each_costly_index(plausible - 1, serial_up_to(1), [&](std::size_t k) {
       refined[k + 1] = refine(refined[k + 1].pose, 0.1, 1 * kDeg, blobs);

@@ -201,6 +201,11 @@ TEST(Hypotheses, BadOptionsAreRefusedByName) {
   o = {};
   o.publish_posterior = 1.5;
   EXPECT_THAT(refused(o), testing::HasSubstr("publish_posterior"));
+  for (const double bad : {-0.1, std::nan(""), HUGE_VAL}) {
+    o = {};
+    o.ceiling_label_sigma_m = bad;
+    EXPECT_THAT(refused(o), testing::HasSubstr("ceiling_label_sigma_m")) << bad;
+  }
 }
 
 TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf10Nodes) { kidnaps_on(10, 10, 10); }
