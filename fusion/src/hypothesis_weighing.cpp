@@ -85,6 +85,11 @@ double HypothesisWeigher::charge_image(
   return delta;
 }
 
+double HypothesisWeigher::misfit(double score, int missing, int unexplained) const {
+  const LampPairOptions& q = omni_->options().pairs;
+  return score - q.miss_cost * missing - q.spurious_cost * unexplained;
+}
+
 Weighed HypothesisWeigher::omni(Hypothesis& h, const vision::OmniDetection& d) const {
   const double ps = std::clamp(sigma_position(h.covariance), 0.03, 1.5);
   const double ys = std::clamp(std::sqrt(h.covariance(2, 2)), 0.5 * kDeg, 15 * kDeg);
@@ -98,12 +103,14 @@ Weighed HypothesisWeigher::omni(Hypothesis& h, const vision::OmniDetection& d) c
     // A misfit better than expected says nothing (map_evidence.hpp, charge_misfit).
     return {r->score + charge_image(h, r->missed, r->unexplained, r->strays, r->lamp_costs) +
                 std::max(0.0, update(h, r->pose, R)),
-            contradicts(r->expected, r->missing, seen, r->unexplained)};
+            contradicts(r->expected, r->missing, seen, r->unexplained) ||
+                misfit(r->score, r->missing, r->unexplained) > o_->odd_image_misfit};
   }
   // Nothing to refine on: the prediction scored as it stands, with its own uncertainty.
   const GlobalLocalizer::PoseScore sc = omni_->score(h.pose, ps, ys, d);
   return {sc.cost + charge_image(h, sc.missed, sc.unexplained, sc.strays, sc.lamp_costs),
-          contradicts(sc.expected, sc.missing, sc.matched + sc.unexplained, sc.unexplained)};
+          contradicts(sc.expected, sc.missing, sc.matched + sc.unexplained, sc.unexplained) ||
+              misfit(sc.cost, sc.missing, sc.unexplained) > o_->odd_image_misfit};
 }
 
 double HypothesisWeigher::unlabelled(Hypothesis& h, const vision::LampDetection& d) const {

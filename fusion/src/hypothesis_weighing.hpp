@@ -62,6 +62,10 @@ class HypothesisWeigher {
 
  private:
   bool placed(const StraySighting& b) const;
+  // What an omni image's score says of the lamps' directions alone, its missing lamps and
+  // unexplained blobs taken out: past HypothesisSetOptions::odd_image_misfit, the image fits
+  // the hypothesis nowhere a right place's images were seen to (12.1 at most).
+  double misfit(double score, int missing, int unexplained) const;
   // Kalman update of a hypothesis with a pose measurement (map_geometry.hpp), its covariance no
   // smaller than odometry between frames allows; returns the normalized innovation squared less
   // its expectation (3).

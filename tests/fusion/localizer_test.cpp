@@ -354,7 +354,9 @@ TEST(Localizer, OmniUpdatesHoldTheHeadingWhereDiscsAreOut) {
 // The wheels do not see a lift, so those places are stale. Until 2026-12-03 the images were
 // enumerated within them only: the image at 73 s scored 102 at the best of them and 2.4 at the
 // truth, and the set published a place 8 m off (caught a second later). Now such an image starts
-// the places again (`stale`, below, is the old behaviour).
+// the places again; and since 2026-12-04 an image whose lamps misfit every hypothesis past
+// odd_image_misfit contradicts them all, which starts the set again too (`stale`, below, is the
+// old behaviour: both off).
 TEST(Localizer, CarriedAwayWhileLostStartsThePlacesAgain) {
   World w("maps/office_floor.geojson");
   w.map = test::edited(w.map, test::sparse_round);
@@ -371,6 +373,7 @@ TEST(Localizer, CarriedAwayWhileLostStartsThePlacesAgain) {
   EXPECT_TRUE(r.recovered_at_end);
   LocalizerOptions stale;
   stale.hypotheses.stale_places_cost = 1e9;
+  stale.hypotheses.odd_image_misfit = 1e9;
   const Outcome before = replay(s, log, w.map, true, stale);
   std::cout << "kept to the drive's places: " << before.summary() << "\n";
   EXPECT_GE(before.bad_fixes, 1);
