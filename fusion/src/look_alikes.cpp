@@ -263,8 +263,10 @@ class Finder {
   static std::pair<long, long> anchor_cell(const Eigen::Vector2d& p) {
     return {std::lround(std::floor(p.x())), std::lround(std::floor(p.y()))};
   }
+  // Shifted as unsigned: a negative cell's left shift is undefined (UBSan found it).
   static std::int64_t cell_key(long x, long y) {
-    return (static_cast<std::int64_t>(x) << 32) ^ static_cast<std::int64_t>(y & 0xffffffff);
+    return static_cast<std::int64_t>((static_cast<std::uint64_t>(x) << 32) ^
+                                     static_cast<std::uint32_t>(y));
   }
   void index_at_anchor(std::size_t k) {
     const auto [x, y] = anchor_cell(found_[k].motion.transform_from(anchor_));
