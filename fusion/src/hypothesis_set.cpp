@@ -349,10 +349,8 @@ struct HypothesisSet::Impl {
     // An image whose best place's lamps misfit past odd_image_misfit weighs its newborns as any
     // frame does: the likeliest then leads the next by at most frame_cost_cap, short of
     // publish_ratio, and it does not decide alone (the truth may not even be among them).
-    const auto& q = omni->options().pairs;
     const PoseHypothesis& likeliest = r.hypotheses[best];
-    const bool odd = likeliest.score - q.miss_cost * likeliest.missing -
-                         q.spurious_cost * likeliest.unexplained >
+    const bool odd = weigher.misfit(likeliest.score, likeliest.missing, likeliest.unexplained) >
                      o.odd_image_misfit;
     const double image_cap = odd ? o.frame_cost_cap : std::numeric_limits<double>::infinity();
     // What the drive said before this image: each hypothesis is born with the cost of the

@@ -59,13 +59,13 @@ class HypothesisWeigher {
   // What an image's `unexplained` blobs that place no lamp well enough for a spot (all but
   // `spots` of them) cost in full: the far account's charge before its bound.
   double far_cost(int unexplained, int spots) const;
-
- private:
-  bool placed(const StraySighting& b) const;
   // What an omni image's score says of the lamps' directions alone, its missing lamps and
   // unexplained blobs taken out: past HypothesisSetOptions::odd_image_misfit, the image fits
   // the hypothesis nowhere a right place's images were seen to (12.1 at most).
   double misfit(double score, int missing, int unexplained) const;
+
+ private:
+  bool placed(const StraySighting& b) const;
   // Kalman update of a hypothesis with a pose measurement (map_geometry.hpp), its covariance no
   // smaller than odometry between frames allows; returns the normalized innovation squared less
   // its expectation (3).
