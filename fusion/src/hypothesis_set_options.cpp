@@ -48,6 +48,9 @@ void HypothesisSetOptions::validate() const {
         "must not be negative");
   check(frame_cost_cap > 0, "frame_cost_cap", "must be positive");
   check(odd_image_misfit > 0, "odd_image_misfit", "must be positive");
+  check(odd_image_cost > 0, "odd_image_cost", "must be positive");
+  check(contradiction_cost >= 0 && std::isfinite(contradiction_cost), "contradiction_cost",
+        "must be finite and not negative");
   check(ceiling_cost_cap > 0, "ceiling_cost_cap", "must be positive");
   check(birth_sigma_m > 0 && birth_sigma_deg > 0, "birth_sigma_m", "must be positive");
   check(kept_prior > 0 && kept_prior < 1, "kept_prior", "must be in (0, 1)");

@@ -101,16 +101,21 @@ Weighed HypothesisWeigher::omni(Hypothesis& h, const vision::OmniDetection& d) c
                                     std::pow(o_->omni_bump_sigma_deg * kDeg, 2));
     const int seen = static_cast<int>(r->matches.size()) + r->unexplained;
     // A misfit better than expected says nothing (map_evidence.hpp, charge_misfit).
-    return {r->score + charge_image(h, r->missed, r->unexplained, r->strays, r->lamp_costs) +
-                std::max(0.0, update(h, r->pose, R)),
-            contradicts(r->expected, r->missing, seen, r->unexplained) ||
-                misfit(r->score, r->missing, r->unexplained) > o_->odd_image_misfit};
+    return judged(r->score + charge_image(h, r->missed, r->unexplained, r->strays, r->lamp_costs) +
+                      std::max(0.0, update(h, r->pose, R)),
+                  contradicts(r->expected, r->missing, seen, r->unexplained) ||
+                      misfit(r->score, r->missing, r->unexplained) > o_->odd_image_misfit);
   }
   // Nothing to refine on: the prediction scored as it stands, with its own uncertainty.
   const GlobalLocalizer::PoseScore sc = omni_->score(h.pose, ps, ys, d);
-  return {sc.cost + charge_image(h, sc.missed, sc.unexplained, sc.strays, sc.lamp_costs),
-          contradicts(sc.expected, sc.missing, sc.matched + sc.unexplained, sc.unexplained) ||
-              misfit(sc.cost, sc.missing, sc.unexplained) > o_->odd_image_misfit};
+  return judged(sc.cost + charge_image(h, sc.missed, sc.unexplained, sc.strays, sc.lamp_costs),
+                contradicts(sc.expected, sc.missing, sc.matched + sc.unexplained, sc.unexplained) ||
+                    misfit(sc.cost, sc.missing, sc.unexplained) > o_->odd_image_misfit);
+}
+
+Weighed HypothesisWeigher::judged(double cost, bool contradicted) const {
+  contradicted = contradicted || cost > o_->odd_image_cost;
+  return {contradicted ? cost + o_->contradiction_cost : cost, contradicted};
 }
 
 double HypothesisWeigher::unlabelled(Hypothesis& h, const vision::LampDetection& d) const {

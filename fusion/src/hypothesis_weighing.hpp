@@ -65,6 +65,10 @@ class HypothesisWeigher {
   double misfit(double score, int missing, int unexplained) const;
 
  private:
+  // An omni image's cost and verdict for one hypothesis: a cost past
+  // HypothesisSetOptions::odd_image_cost contradicts it too, and a contradiction is charged as
+  // the evidence it is (contradiction_cost).
+  Weighed judged(double cost, bool contradicted) const;
   bool placed(const StraySighting& b) const;
   // Kalman update of a hypothesis with a pose measurement (map_geometry.hpp), its covariance no
   // smaller than odometry between frames allows; returns the normalized innovation squared less

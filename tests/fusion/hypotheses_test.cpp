@@ -196,6 +196,15 @@ TEST(Hypotheses, BadOptionsAreRefusedByName) {
   o.odd_image_misfit = std::nan("");
   EXPECT_THAT(refused(o), testing::HasSubstr("odd_image_misfit"));
   o = {};
+  o.odd_image_cost = std::nan("");
+  EXPECT_THAT(refused(o), testing::HasSubstr("odd_image_cost"));
+  o = {};
+  o.contradiction_cost = HUGE_VAL;
+  EXPECT_THAT(refused(o), testing::HasSubstr("contradiction_cost"));
+  o = {};
+  o.contradiction_cost = -1;
+  EXPECT_THAT(refused(o), testing::HasSubstr("contradiction_cost"));
+  o = {};
   o.frame_cost_cap = -1;
   EXPECT_THAT(refused(o), testing::HasSubstr("frame_cost_cap"));
   o = {};
