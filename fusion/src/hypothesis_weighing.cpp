@@ -103,18 +103,19 @@ Weighed HypothesisWeigher::omni(Hypothesis& h, const vision::OmniDetection& d) c
     // A misfit better than expected says nothing (map_evidence.hpp, charge_misfit).
     return judged(r->score + charge_image(h, r->missed, r->unexplained, r->strays, r->lamp_costs) +
                       std::max(0.0, update(h, r->pose, R)),
-                  contradicts(r->expected, r->missing, seen, r->unexplained) ||
-                      misfit(r->score, r->missing, r->unexplained) > o_->odd_image_misfit);
+                  r->score, r->expected, r->missing, seen, r->unexplained);
   }
   // Nothing to refine on: the prediction scored as it stands, with its own uncertainty.
   const GlobalLocalizer::PoseScore sc = omni_->score(h.pose, ps, ys, d);
   return judged(sc.cost + charge_image(h, sc.missed, sc.unexplained, sc.strays, sc.lamp_costs),
-                contradicts(sc.expected, sc.missing, sc.matched + sc.unexplained, sc.unexplained) ||
-                    misfit(sc.cost, sc.missing, sc.unexplained) > o_->odd_image_misfit);
+                sc.cost, sc.expected, sc.missing, sc.matched + sc.unexplained, sc.unexplained);
 }
 
-Weighed HypothesisWeigher::judged(double cost, bool contradicted) const {
-  contradicted = contradicted || cost > o_->odd_image_cost;
+Weighed HypothesisWeigher::judged(double cost, double score, int expected, int missing, int seen,
+                                  int unexplained) const {
+  const bool contradicted = contradicts(expected, missing, seen, unexplained) ||
+                            misfit(score, missing, unexplained) > o_->odd_image_misfit ||
+                            cost > o_->odd_image_cost;
   return {contradicted ? cost + o_->contradiction_cost : cost, contradicted};
 }
 

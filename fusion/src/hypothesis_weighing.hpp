@@ -18,10 +18,9 @@
 
 namespace lampnav::fusion::detail {
 
-// -2 ln L of one frame for one hypothesis, and whether the frame plainly contradicts it (most of
-// the lamps it predicts in clear view unseen, or most of the lamps seen unexplained). Only an omni
-// frame sees enough of the ceiling to judge that; a ceiling frame leaves it unjudged, and the
-// hypothesis keeps what the last omni frame said of it.
+// -2 ln L of one frame for one hypothesis, and whether the frame contradicts it (judged(), below).
+// Only an omni frame sees enough of the ceiling to judge that; a ceiling frame leaves it
+// unjudged, and the hypothesis keeps what the last omni frame said of it.
 struct Weighed {
   double cost = 0;
   std::optional<bool> contradicted;
@@ -65,10 +64,13 @@ class HypothesisWeigher {
   double misfit(double score, int missing, int unexplained) const;
 
  private:
-  // An omni image's cost and verdict for one hypothesis: a cost past
-  // HypothesisSetOptions::odd_image_cost contradicts it too, and a contradiction is charged as
-  // the evidence it is (contradiction_cost).
-  Weighed judged(double cost, bool contradicted) const;
+  // An omni image's verdict on one hypothesis, from its `cost` after the ledgers, its `score` and
+  // its counts (`seen`: blobs matched or unexplained): contradicted when most lamps expected in
+  // clear view are unseen or most blobs unexplained, when the lamps' directions misfit past
+  // HypothesisSetOptions::odd_image_misfit, or when the cost passes odd_image_cost. A
+  // contradiction is charged as the evidence it is (contradiction_cost).
+  Weighed judged(double cost, double score, int expected, int missing, int seen,
+                 int unexplained) const;
   bool placed(const StraySighting& b) const;
   // Kalman update of a hypothesis with a pose measurement (map_geometry.hpp), its covariance no
   // smaller than odometry between frames allows; returns the normalized innovation squared less
