@@ -329,15 +329,16 @@ struct HypothesisSet::Impl {
     std::size_t n = 0;
     while (n < r.hypotheses.size() && r.hypotheses[n].score <= best_score + margin) ++n;
     // Weighed with each lamp the image missed costing at most lamp_out_cost, each blob no lamp
-    // explains at most unmapped_lamp_cost, the far ones at most far_stray_cost_max together.
+    // explains at most unmapped_lamp_cost, the far ones as the far account charges them.
     const auto capped = [&](const PoseHypothesis& h) {
       const auto& q = omni->options().pairs;
-      const int spots = weigher.placed_strays(h.strays);  // each stray asks the map once
-      const double far = weigher.far_cost(h.unexplained, spots);
+      const auto strays = weigher.count_strays(h.strays);  // each stray asks the map once
+      const double far = weigher.far_cost(h.unexplained, strays.spots);
+      double spent = 0;
       return detail::with_each_bounded(
-                 detail::with_each_bounded(h.score, h.missing, q.miss_cost, o.lamp_out_cost), spots,
-                 q.spurious_cost, o.unmapped_lamp_cost) -
-             far + std::min(far, o.far_stray_cost_max);
+                 detail::with_each_bounded(h.score, h.missing, q.miss_cost, o.lamp_out_cost),
+                 strays.spots, q.spurious_cost, o.unmapped_lamp_cost) -
+             far + weigher.far_charge(spent, h.unexplained - strays.spots, strays.beyond);
     };
     double capped_best = capped(r.hypotheses.front());
     std::size_t best = 0;

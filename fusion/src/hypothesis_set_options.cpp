@@ -69,6 +69,8 @@ void HypothesisSetOptions::validate() const {
   check(stray_radius_m > 0, "stray_radius_m", "must be positive");
   check(stray_reach_max_m >= 0, "stray_reach_max_m", "must not be negative");
   check(far_stray_cost_max >= 0, "far_stray_cost_max", "must not be negative");
+  check(beyond_map_blob_cost >= 0 && std::isfinite(beyond_map_blob_cost), "beyond_map_blob_cost",
+        "must be finite and not negative");
   check(map_sigma_m >= 0, "map_sigma_m", "must not be negative");
   check(fit_gate_probability > 0 && fit_gate_probability < 1, "fit_gate_probability",
         "must be in (0, 1)");

@@ -45,21 +45,34 @@ double HypothesisWeigher::update(Hypothesis& h, const Pose2& z, const Eigen::Mat
   return update_pose(h.pose, h.covariance, z, R, o_->sigma_m, o_->sigma_yaw_deg * kDeg);
 }
 
-bool HypothesisWeigher::placed(const StraySighting& b) const {
-  return b.reach <= o_->stray_reach_max_m && (o_->count_beyond_map || !beyond_places(b));
+HypothesisWeigher::StrayKind HypothesisWeigher::kind(const StraySighting& b) const {
+  if (b.reach > o_->stray_reach_max_m) return StrayKind::far;
+  return o_->count_beyond_map || !beyond_places(b) ? StrayKind::spot : StrayKind::beyond;
 }
 
 bool HypothesisWeigher::beyond_places(const StraySighting& b) const {
   return map_->node_near(b.at, b.reach) == nullptr;
 }
 
-int HypothesisWeigher::placed_strays(const std::vector<StraySighting>& strays) const {
-  return static_cast<int>(std::count_if(strays.begin(), strays.end(),
-                                        [&](const StraySighting& b) { return placed(b); }));
+HypothesisWeigher::StrayCounts HypothesisWeigher::count_strays(
+    const std::vector<StraySighting>& strays) const {
+  StrayCounts n;
+  for (const StraySighting& b : strays) {
+    const StrayKind k = kind(b);
+    n.spots += k == StrayKind::spot;
+    n.beyond += k == StrayKind::beyond;
+  }
+  return n;
 }
 
 double HypothesisWeigher::far_cost(int unexplained, int spots) const {
   return omni_->options().pairs.spurious_cost * std::max(0, unexplained - spots);
+}
+
+double HypothesisWeigher::far_charge(double& spent, int far_blobs, int beyond) const {
+  const double account = charge_account(
+      spent, omni_->options().pairs.spurious_cost * std::max(0, far_blobs), o_->far_stray_cost_max);
+  return std::max(account, o_->beyond_map_blob_cost * beyond);
 }
 
 double HypothesisWeigher::charge_image(
@@ -70,16 +83,22 @@ double HypothesisWeigher::charge_image(
   const double stray = omni_->options().pairs.spurious_cost;
   double delta = charge_absences(h.map_costs.lamps, missed, each, o_->lamp_out_cost) -
                  each * static_cast<double>(missed.size());
-  int spots = 0;  // placed() asks the map: once a stray
-  for (const StraySighting& b : strays)
-    if (placed(b)) {
-      ++spots;
-      delta += charge_stray(h.map_costs.strays, b.at, std::max(o_->stray_radius_m, b.reach), stray,
-                            o_->unmapped_lamp_cost) -
-               stray;
+  int spots = 0, beyond = 0;  // kind() asks the map: once a stray
+  for (const StraySighting& b : strays) switch (kind(b)) {
+      case StrayKind::spot:
+        ++spots;
+        delta += charge_stray(h.map_costs.strays, b.at, std::max(o_->stray_radius_m, b.reach),
+                              stray, o_->unmapped_lamp_cost) -
+                 stray;
+        break;
+      case StrayKind::beyond:
+        ++beyond;
+        break;
+      case StrayKind::far:
+        break;
     }
   const double far = far_cost(unexplained, spots);
-  delta += charge_account(h.map_costs.far_strays, far, o_->far_stray_cost_max) - far;
+  delta += far_charge(h.map_costs.far_strays, unexplained - spots, beyond) - far;
   for (const auto& [l, c] : lamp_costs)
     delta += charge_misfit(h.map_costs.misfits, l, c, o_->lamp_out_cost) - c;
   return delta;

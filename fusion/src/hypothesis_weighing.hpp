@@ -48,16 +48,28 @@ class HypothesisWeigher {
   double charge_image(Hypothesis& h, const std::vector<const graph::Lamp*>& missed, int unexplained,
                       const std::vector<StraySighting>& strays,
                       const std::vector<std::pair<const graph::Lamp*, double>>& lamp_costs) const;
-  // How many of an image's strays place their lamp well enough to be charged to a spot: near
-  // enough, and within its reach of one of the map's places unless count_beyond_map. (Asked only
-  // of the near ones: a far stray's reach spans many places, and the search through them cost as
-  // much as weighing the hypothesis.)
-  int placed_strays(const std::vector<StraySighting>& strays) const;
+  // Where an omni blob no lamp explains (a stray) is charged: to a spot of its own when it places
+  // its lamp near enough (stray_reach_max_m) and, unless count_beyond_map, within its reach of
+  // one of the map's places; to the far account otherwise, as a lamp placed well but beyond every
+  // place (`beyond`) or as one placed too loosely to tell where (`far`). (The map is asked only
+  // of the near ones: a far stray's reach spans many places, and the search through them cost
+  // as much as weighing the hypothesis.)
+  enum class StrayKind { spot, beyond, far };
+  StrayKind kind(const StraySighting& b) const;
   // Whether a stray's lamp would lie beyond every place of the map (further than its reach).
   bool beyond_places(const StraySighting& b) const;
+  struct StrayCounts {
+    int spots = 0;
+    int beyond = 0;
+  };
+  StrayCounts count_strays(const std::vector<StraySighting>& strays) const;
   // What an image's `unexplained` blobs that place no lamp well enough for a spot (all but
   // `spots` of them) cost in full: the far account's charge before its bound.
   double far_cost(int unexplained, int spots) const;
+  // What the far account charges for an image's `far_blobs` (`beyond` of them placed well but
+  // beyond the map's places), `spent` being what it has charged the hypothesis before: at most
+  // far_stray_cost_max in all, and never less than beyond_map_blob_cost for each of `beyond`.
+  double far_charge(double& spent, int far_blobs, int beyond) const;
   // What an omni image's score says of the lamps' directions alone, its missing lamps and
   // unexplained blobs taken out: past HypothesisSetOptions::odd_image_misfit, the image fits
   // the hypothesis nowhere a right place's images were seen to (12.1 at most).
@@ -71,7 +83,6 @@ class HypothesisWeigher {
   // contradiction is charged as the evidence it is (contradiction_cost).
   Weighed judged(double cost, double score, int expected, int missing, int seen,
                  int unexplained) const;
-  bool placed(const StraySighting& b) const;
   // Kalman update of a hypothesis with a pose measurement (map_geometry.hpp), its covariance no
   // smaller than odometry between frames allows; returns the normalized innovation squared less
   // its expectation (3).

@@ -204,6 +204,11 @@ TEST(Hypotheses, BadOptionsAreRefusedByName) {
   o = {};
   o.contradiction_cost = -1;
   EXPECT_THAT(refused(o), testing::HasSubstr("contradiction_cost"));
+  for (const double bad : {-0.1, std::nan(""), HUGE_VAL}) {
+    o = {};
+    o.beyond_map_blob_cost = bad;
+    EXPECT_THAT(refused(o), testing::HasSubstr("beyond_map_blob_cost")) << bad;
+  }
   o = {};
   o.frame_cost_cap = -1;
   EXPECT_THAT(refused(o), testing::HasSubstr("frame_cost_cap"));

@@ -180,6 +180,17 @@ struct HypothesisSetOptions {
   // the map lacks), the far view alone never makes a place certain (publish_ratio is 13.8);
   // lamps seen near, and lamps the map has and the image lacks, still do.
   double far_stray_cost_max = 9.2;
+  // What each blob the far account holds whose lamp the image places well (within
+  // stray_reach_max_m) but beyond every place of the map costs an image at least, the account
+  // spent or not. Were such a blob free once the account is spent, leaving a blob unexplained
+  // would be cheaper than explaining it: a twin 48 m along the truth's corridor left 3 to 23 of
+  // each image's blobs (lamps the truth matched) beyond the map's end, paid nothing for them after
+  // its first images, and was published 48 m off (a regular building with failed lamps,
+  // docs/hypotheses.md, "Blobs beyond the map"). 2 is a matched blob's expected cost (a
+  // direction's chi-square, two degrees of freedom); 0.5 and 1 still published that twin. On a
+  // whole building's map the truth leaves no such blob; on a map of part of one it leaves those
+  // of the lamps past the map's ends, and pays for them alike wherever it is.
+  double beyond_map_blob_cost = 2.0;
   // Whether an omni blob no lamp explains, whose lamp would lie beyond every place of the map
   // (farther than its StraySighting::reach from each), is charged to a spot like the others
   // (true) or to the far account (false). A map built from one drive holds the corridors the drive
