@@ -5,6 +5,7 @@
 
 #include <random>
 
+#include "hypothesis_weighing.hpp"
 #include "lampnav/fusion/global_localizer.hpp"
 #include "lampnav/fusion/hypothesis_set.hpp"
 #include "lampnav/graph/geojson.hpp"
@@ -138,6 +139,49 @@ TEST(PartialMap, LampsBeyondTheMapCostTheTruthOneBoundedAccount) {
   EXPECT_GE(each_a_spot.spots, 2u);
   // More than one lamp the map lacks costs (unmapped_lamp_cost) saved.
   EXPECT_GT(each_a_spot.total - beyond_far.total, HypothesisSetOptions{}.unmapped_lamp_cost);
+}
+
+// Where the blobs no lamp explains are charged (HypothesisWeigher): a lamp placed well within a
+// place of the map, to a spot of its own; placed well beyond every place, to the far account and
+// never less than beyond_map_blob_cost an image, the account spent or not (a twin that left the
+// truth's blobs beyond the map's end paid nothing for them once its account was spent, and was
+// published 48 m off: FailedLampsAndCarries.BlobsLeftBeyondTheMapAreNeverFree); placed loosely
+// (a lamp the map lacks, seen far off), to the far account alone, at most far_stray_cost_max in
+// all.
+TEST(PartialMap, BlobsPlacedBeyondTheMapAreChargedInEveryImage) {
+  using detail::HypothesisWeigher;
+  const PartialOffice o;
+  const GlobalLocalizer omni(o.built, o.cam());
+  const HypothesisSetOptions opt;
+  const HypothesisWeigher w(o.built, nullptr, &omni, CeilingPipelineOptions{}, opt);
+  const Eigen::Vector2d in_a_place = (*o.built.nodes().begin()).point;
+  const Eigen::Vector2d nowhere = in_a_place + Eigen::Vector2d(200, 200);
+  ASSERT_EQ(o.built.node_near(nowhere, 5.0), nullptr);
+  EXPECT_EQ(w.kind({in_a_place, 0.3}), HypothesisWeigher::StrayKind::spot);
+  EXPECT_EQ(w.kind({nowhere, 0.3}), HypothesisWeigher::StrayKind::beyond);
+  EXPECT_EQ(w.kind({nowhere, opt.stray_reach_max_m + 0.5}), HypothesisWeigher::StrayKind::far);
+  const auto n = w.count_strays({{in_a_place, 0.3}, {nowhere, 0.3}, {nowhere, 0.2}, {nowhere, 3}});
+  EXPECT_EQ(n.spots, 1);
+  EXPECT_EQ(n.beyond, 2);
+
+  // Three far blobs an image, two of them placed beyond the map: the account first, up to its
+  // bound, then the floor on the two.
+  double spent = 0;
+  double charged = 0;
+  for (int image = 0; image < 5; ++image) {
+    const double c = w.far_charge(spent, 3, 2);
+    EXPECT_GE(c, 2 * opt.beyond_map_blob_cost - 1e-12) << "image " << image;
+    charged += c;
+  }
+  EXPECT_DOUBLE_EQ(spent, opt.far_stray_cost_max);
+  EXPECT_NEAR(charged, opt.far_stray_cost_max + 4 * 2 * opt.beyond_map_blob_cost, 1e-9);
+  // Loosely placed blobs alone cost nothing more once the account is spent.
+  EXPECT_EQ(w.far_charge(spent, 3, 0), 0.0);
+
+  HypothesisSetOptions whole = opt;
+  whole.count_beyond_map = true;
+  const HypothesisWeigher counted(o.built, nullptr, &omni, CeilingPipelineOptions{}, whole);
+  EXPECT_EQ(counted.kind({nowhere, 0.3}), HypothesisWeigher::StrayKind::spot);
 }
 
 }  // namespace
