@@ -183,7 +183,7 @@ struct HypothesisSetOptions {
   // What each blob the far account holds whose lamp the image places well (within
   // stray_reach_max_m) but beyond every place of the map costs an image at least, the account
   // spent or not. Were such a blob free once the account is spent, leaving a blob unexplained
-  // would be cheaper than explaining it: a twin 48 m along the truth's corridor left 3 to 23 of
+  // would be cheaper than explaining it: a twin 48 m along the truth's corridor left up to 23 of
   // each image's blobs (lamps the truth matched) beyond the map's end, paid nothing for them after
   // its first images, and was published 48 m off (a regular building with failed lamps,
   // docs/hypotheses.md, "Blobs beyond the map"). 2 is a matched blob's expected cost (a
