@@ -338,7 +338,7 @@ struct HypothesisSet::Impl {
       return detail::with_each_bounded(
                  detail::with_each_bounded(h.score, h.missing, q.miss_cost, o.lamp_out_cost),
                  strays.spots, q.spurious_cost, o.unmapped_lamp_cost) -
-             far + weigher.far_charge(spent, h.unexplained - strays.spots, strays.beyond);
+             far + weigher.far_charge(spent, far, strays.beyond);
     };
     double capped_best = capped(r.hypotheses.front());
     std::size_t best = 0;

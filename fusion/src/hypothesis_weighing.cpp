@@ -69,10 +69,9 @@ double HypothesisWeigher::far_cost(int unexplained, int spots) const {
   return omni_->options().pairs.spurious_cost * std::max(0, unexplained - spots);
 }
 
-double HypothesisWeigher::far_charge(double& spent, int far_blobs, int beyond) const {
-  const double account = charge_account(
-      spent, omni_->options().pairs.spurious_cost * std::max(0, far_blobs), o_->far_stray_cost_max);
-  return std::max(account, o_->beyond_map_blob_cost * beyond);
+double HypothesisWeigher::far_charge(double& spent, double far, int beyond) const {
+  return std::max(charge_account(spent, far, o_->far_stray_cost_max),
+                  o_->beyond_map_blob_cost * beyond);
 }
 
 double HypothesisWeigher::charge_image(
@@ -98,7 +97,7 @@ double HypothesisWeigher::charge_image(
         break;
     }
   const double far = far_cost(unexplained, spots);
-  delta += far_charge(h.map_costs.far_strays, unexplained - spots, beyond) - far;
+  delta += far_charge(h.map_costs.far_strays, far, beyond) - far;
   for (const auto& [l, c] : lamp_costs)
     delta += charge_misfit(h.map_costs.misfits, l, c, o_->lamp_out_cost) - c;
   return delta;

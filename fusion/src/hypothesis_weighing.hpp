@@ -66,10 +66,11 @@ class HypothesisWeigher {
   // What an image's `unexplained` blobs that place no lamp well enough for a spot (all but
   // `spots` of them) cost in full: the far account's charge before its bound.
   double far_cost(int unexplained, int spots) const;
-  // What the far account charges for an image's `far_blobs` (`beyond` of them placed well but
-  // beyond the map's places), `spent` being what it has charged the hypothesis before: at most
-  // far_stray_cost_max in all, and never less than beyond_map_blob_cost for each of `beyond`.
-  double far_charge(double& spent, int far_blobs, int beyond) const;
+  // What the far account charges for an image's far blobs, `far` (far_cost) in full, `beyond` of
+  // them placed well but beyond the map's places; `spent` is what it has charged the hypothesis
+  // before: at most far_stray_cost_max in all, and never less than beyond_map_blob_cost for
+  // each of `beyond`.
+  double far_charge(double& spent, double far, int beyond) const;
   // What an omni image's score says of the lamps' directions alone, its missing lamps and
   // unexplained blobs taken out: past HypothesisSetOptions::odd_image_misfit, the image fits
   // the hypothesis nowhere a right place's images were seen to (12.1 at most).

@@ -169,14 +169,14 @@ TEST(PartialMap, BlobsPlacedBeyondTheMapAreChargedInEveryImage) {
   double spent = 0;
   double charged = 0;
   for (int image = 0; image < 5; ++image) {
-    const double c = w.far_charge(spent, 3, 2);
+    const double c = w.far_charge(spent, w.far_cost(3, 0), 2);
     EXPECT_GE(c, 2 * opt.beyond_map_blob_cost - 1e-12) << "image " << image;
     charged += c;
   }
   EXPECT_DOUBLE_EQ(spent, opt.far_stray_cost_max);
   EXPECT_NEAR(charged, opt.far_stray_cost_max + 4 * 2 * opt.beyond_map_blob_cost, 1e-9);
   // Loosely placed blobs alone cost nothing more once the account is spent.
-  EXPECT_EQ(w.far_charge(spent, 3, 0), 0.0);
+  EXPECT_EQ(w.far_charge(spent, w.far_cost(3, 0), 0), 0.0);
 
   HypothesisSetOptions whole = opt;
   whole.count_beyond_map = true;
