@@ -349,7 +349,9 @@ struct HypothesisSet::Impl {
       }
     // An image whose best place's lamps misfit past odd_image_misfit weighs its newborns as any
     // frame does: the likeliest then leads the next by at most frame_cost_cap, short of
-    // publish_ratio, and it does not decide alone (the truth may not even be among them).
+    // publish_ratio. Nor does it complete the set: the truth may not even be among its places
+    // (born only within birth_ratio of a best that fits nowhere well), and a complete set never
+    // takes a place in again.
     const PoseHypothesis& likeliest = r.hypotheses[best];
     const bool odd = weigher.misfit(likeliest.score, likeliest.missing, likeliest.unexplained) >
                      o.odd_image_misfit;
@@ -369,7 +371,7 @@ struct HypothesisSet::Impl {
     // A place of the drive this image did not allow still counts while its cost stays within
     // place_cost_max (one odd image, a lamp hidden, never removes the truth): it is born too,
     // at its cost, and the frames that follow weigh it like the others.
-    if (r.complete && n + missed.size() <= std::size_t(o.max_hypotheses)) {
+    if (r.complete && !odd && n + missed.size() <= std::size_t(o.max_hypotheses)) {
       ++counts.complete_enumerations;
       std::vector<Hypothesis> next;
       double kept_share = 0;
@@ -400,13 +402,18 @@ struct HypothesisSet::Impl {
       last_enumeration.reset();
       omni_frames = 1;  // this image weighed them
       view_beyond_map = beyond_map(r.hypotheses.front());
-      decided_by_one_image = !r_with_prior && !view_beyond_map && !odd;
+      decided_by_one_image = !r_with_prior && !view_beyond_map;
       completed_at = stamp;
       travel_since_complete = 0;
       last_why.clear();
       return;
     }
-    last_why = r.why.empty() ? "the image fits more places than were enumerated" : r.why;
+    if (r.complete && odd) {
+      ++counts.odd_images;
+      last_why = "the image's lamps fit no place well: its places may not hold the robot";
+    } else {
+      last_why = r.why.empty() ? "the image fits more places than were enumerated" : r.why;
+    }
     for (std::size_t k = 0; k < n; ++k)
       hs.push_back(born(r.hypotheses[k], stamp, odo, -0.5 * cost_of(r.hypotheses[k])));
   }

@@ -98,7 +98,10 @@ struct HypothesisSetOptions {
   // lamps and the tilt they needed, its missed lamps and unexplained blobs left out) fits no
   // place as an image fits the truth: a floor bump past the models, a person under the lamps.
   // Its newborns are weighed as every later frame weighs them, each at most frame_cost_cap
-  // behind the likeliest, and it does not decide alone: the truth may not be among them.
+  // behind the likeliest, and it neither decides alone nor completes the set: the truth may not
+  // be among them. Completed by one (best 59, the truth 36 behind it and not born) on a floor
+  // swinging the cameras 1.5 degrees, a set published a place 60 m along the truth's corridor
+  // (docs/hypotheses.md, "An odd image completes no set").
   // Born from such an image (misfit 52) after a false alarm on a floor swinging the cameras 1.5
   // degrees, a twin corridor 28 m off led the truth by 39 and was published for 22.7 s. No image
   // of the default floor's office drives passed 4.4, nor of the museum's kidnaps 4.1, nor of the
@@ -311,6 +314,7 @@ class HypothesisSet {
                   enumerations = 0, complete_enumerations = 0;
     std::uint64_t place_restarts = 0;  // the places the drive allowed all lost: started again
     std::uint64_t stale_places = 0;    // an image alone far likelier elsewhere: started again
+    std::uint64_t odd_images = 0;      // complete enumerations whose image fit no place (not taken)
   };
   const Counts& counts() const;
   const HypothesisSetOptions& options() const;
