@@ -408,12 +408,10 @@ struct HypothesisSet::Impl {
       last_why.clear();
       return;
     }
-    if (r.complete && odd) {
-      ++counts.odd_images;
+    if (r.complete && odd)
       last_why = "the image's lamps fit no place well: its places may not hold the robot";
-    } else {
+    else
       last_why = r.why.empty() ? "the image fits more places than were enumerated" : r.why;
-    }
     for (std::size_t k = 0; k < n; ++k)
       hs.push_back(born(r.hypotheses[k], stamp, odo, -0.5 * cost_of(r.hypotheses[k])));
   }

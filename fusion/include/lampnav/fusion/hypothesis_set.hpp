@@ -314,7 +314,6 @@ class HypothesisSet {
                   enumerations = 0, complete_enumerations = 0;
     std::uint64_t place_restarts = 0;  // the places the drive allowed all lost: started again
     std::uint64_t stale_places = 0;    // an image alone far likelier elsewhere: started again
-    std::uint64_t odd_images = 0;      // complete enumerations whose image fit no place (not taken)
   };
   const Counts& counts() const;
   const HypothesisSetOptions& options() const;
