@@ -12,6 +12,7 @@
 #include "lampnav/core/error.hpp"
 #include "lampnav/core/parallel.hpp"
 #include "pose_grid.hpp"
+#include "pose_votes.hpp"
 #include "spurious_blobs.hpp"
 
 namespace lampnav::fusion {
@@ -83,7 +84,7 @@ void GlobalLocalizer::Impl::pair_poses(const Seeds& s, std::size_t j, std::size_
 }
 
 namespace {
-// The voting cell of a pose: 0.25 m x 3 degrees.
+// The cell of a pose in the exhaustive search, which keeps one pose a cell: 0.25 m x 3 degrees.
 std::int64_t cell_of(const Pose2& p) {
   const double cell_m = 0.25, cell_rad = 3 * kDeg;
   return (std::int64_t(std::floor(p.x() / cell_m)) * 1000003 +
@@ -112,55 +113,27 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
   }
   // Vote: every pair of seeds matched to a pair of lamps at the same spacing is a pose. The
   // lamp pairs come from the index, looked up by spacing.
-  struct Cell {
-    int votes = 0;
-    double x = 0, y = 0, c = 0, s = 0;
-  };
-  std::unordered_map<std::int64_t, Cell> cells;
-  cells.reserve(4096);
+  PoseVotes votes;
   for (std::size_t j = 0; j < ns; ++j)
     for (std::size_t k = j + 1; k < ns; ++k)
-      pair_poses(seeds, j, k, [&](const Pose2& p) {
-        Cell& cell = cells[cell_of(p)];
-        ++cell.votes;
-        cell.x += p.x();
-        cell.y += p.y();
-        cell.c += std::cos(p.yaw());
-        cell.s += std::sin(p.yaw());
-      });
-  // The most voted cells, best first (ties by key, so that the result never depends on the hash
-  // map's order); only the few that can be scored are sorted.
-  std::vector<std::pair<int, std::int64_t>> ranked;
-  ranked.reserve(cells.size());
-  for (const auto& [key, cell] : cells) ranked.emplace_back(cell.votes, key);
-  auto better = [](const auto& a, const auto& b) {
-    return a.first != b.first ? a.first > b.first : a.second < b.second;
-  };
-  const std::size_t keep = std::min<std::size_t>(ranked.size(), 8 * q.candidates);
-  std::partial_sort(ranked.begin(), ranked.begin() + keep, ranked.end(), better);
-  std::vector<std::pair<int, Pose2>> voted;
-  for (std::size_t r = 0; r < keep; ++r) {
-    const Cell& cell = cells.at(ranked[r].second);
-    voted.emplace_back(cell.votes,
-                       Pose2(cell.x / cell.votes, cell.y / cell.votes, std::atan2(cell.s, cell.c)));
-  }
+      pair_poses(seeds, j, k, [&](const Pose2& p) { votes.add(p); });
+  // The most voted places, best first; only the few that can be scored.
+  const std::vector<PoseVotes::Place> voted = votes.best(8 * std::size_t(q.candidates));
   // The graph: a robot stands in a node's region.
   std::vector<std::pair<double, Pose2>> scored;
-  std::size_t handled = 0;  // voted cells scored or found outside the regions
-  for (const auto& [votes, pose] : voted) {
+  std::size_t handled = 0;  // voted places scored or found outside the regions
+  for (const PoseVotes::Place& place : voted) {
     if (int(scored.size()) >= q.candidates) break;
     ++handled;
-    if (q.restrict_to_graph && has_regions && !node_of(pose)) continue;
-    scored.emplace_back(evaluate(pose, {}, 0.3, 3 * kDeg, q.tilt_sigma_deg * kDeg, blobs).cost,
-                        pose);
+    if (q.restrict_to_graph && has_regions && !node_of(place.pose)) continue;
+    scored.emplace_back(
+        evaluate(place.pose, {}, 0.3, 3 * kDeg, q.tilt_sigma_deg * kDeg, blobs).cost, place.pose);
   }
   // On a regular ceiling many places get the most votes alike (the lamps near the axis repeat);
   // when more of them reach the top votes than could be scored, the search did not see them all,
   // and says so.
-  std::size_t tied = 0;
-  const int top_votes = voted.empty() ? 0 : voted.front().first;
-  for (const auto& rv : ranked) tied += rv.first == top_votes ? 1 : 0;
-  const bool truncated = !scored.empty() && tied > handled;
+  const bool truncated =
+      !scored.empty() && votes.places_with_at_least(voted.front().votes, handled) > handled;
   out.merit_evaluations = static_cast<int>(scored.size());
   if (scored.empty()) {
     out.why = voted.empty() ? "no pair of map lamps is spaced like any pair of the " +
@@ -180,9 +153,9 @@ GlobalLocalization GlobalLocalizer::Impl::lamp_pairs(const vision::OmniDetection
   out.complete = !truncated && out.plausible < max_hypotheses;
   if (truncated && out.found()) {
     out.ambiguous = true;
-    out.why = std::to_string(tied) + " places look alike to the lamps near the optical axis (a " +
-              "regular ceiling); the " + std::to_string(scored.size()) +
-              " scored are not all of them: more images are needed to choose";
+    out.why = "more places look alike to the lamps near the optical axis than the " +
+              std::to_string(scored.size()) +
+              " scored (a regular ceiling): more images are needed to choose";
   }
   return out;
 }
