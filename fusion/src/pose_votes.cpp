@@ -12,6 +12,9 @@ constexpr int kGrids = 8;
 constexpr double kCellRad = PoseVotes::kCellDeg * M_PI / 180;
 constexpr std::int64_t kTurn = 120;  // yaw cells in a turn: 360 / 3 degrees
 
+// floor(v) as an integer, clamped first so that no coordinate converts out of range.
+std::int64_t whole(double v) { return std::int64_t(std::floor(std::clamp(v, -1e15, 1e15))); }
+
 // Two places within a cell of each other along every axis: one place.
 bool same_place(const Pose2& a, const Pose2& b) {
   return std::abs(a.x() - b.x()) < PoseVotes::kCellM &&
@@ -25,8 +28,8 @@ class Distinct {
  public:
   // Whether p is a place not seen yet; if so it is kept.
   bool insert(const Pose2& p) {
-    const std::int64_t ix = std::int64_t(std::floor(p.x() / PoseVotes::kCellM));
-    const std::int64_t iy = std::int64_t(std::floor(p.y() / PoseVotes::kCellM));
+    const std::int64_t ix = whole(p.x() / PoseVotes::kCellM);
+    const std::int64_t iy = whole(p.y() / PoseVotes::kCellM);
     for (std::int64_t dx = -1; dx <= 1; ++dx)
       for (std::int64_t dy = -1; dy <= 1; ++dy) {
         const auto it = squares_.find(key(ix + dx, iy + dy));
@@ -39,7 +42,9 @@ class Distinct {
   }
 
  private:
-  static std::int64_t key(std::int64_t ix, std::int64_t iy) { return ix * 1000003 + iy; }
+  static std::int64_t key(std::int64_t ix, std::int64_t iy) {
+    return static_cast<std::int64_t>(std::uint64_t(ix) * 1000003u + std::uint64_t(iy));
+  }
   std::unordered_map<std::int64_t, std::vector<Pose2>> squares_;
 };
 
@@ -92,9 +97,8 @@ void PoseVotes::count() {
   std::vector<Halves> halves(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Pose2& p = poses_[i];
-    halves[i] = {std::int64_t(std::floor(2 * p.x() / kCellM)),
-                 std::int64_t(std::floor(2 * p.y() / kCellM)),
-                 std::int64_t(std::floor(2 * (p.yaw() + M_PI) / kCellRad))};
+    halves[i] = {whole(2 * p.x() / kCellM), whole(2 * p.y() / kCellM),
+                 whole(2 * (p.yaw() + M_PI) / kCellRad)};
   }
   std::size_t capacity = 16;
   while (capacity < 2 * n) capacity *= 2;
@@ -111,10 +115,15 @@ void PoseVotes::count() {
     for (std::size_t i = 0; i < n; ++i) {
       const Halves& p = halves[i];
       const std::int64_t a = half_down(p.a + sa);
-      const std::int64_t key = ((half_down(p.x + sx) * 1000003 + half_down(p.y + sy)) * 1009 +
-                                (a >= kTurn ? a - kTurn : a)) *
-                                   kGrids +
-                               g;
+      // Unsigned: a map thousands of kilometres across wraps the key instead of overflowing it
+      // (the same key as signed arithmetic gives wherever that does not overflow).
+      const std::uint64_t u =
+          ((std::uint64_t(half_down(p.x + sx)) * 1000003u + std::uint64_t(half_down(p.y + sy))) *
+               1009u +
+           std::uint64_t(a >= kTurn ? a - kTurn : a)) *
+              kGrids +
+          std::uint64_t(g);
+      const std::int64_t key = static_cast<std::int64_t>(u);
       std::size_t h = mix(key) & mask;
       while (table[h].votes != 0 && table[h].key != key) h = (h + 1) & mask;
       Slot& slot = table[h];

@@ -72,6 +72,19 @@ TEST(PoseVotes, EachPlaceOnceAndCountsStopPastTheirLimit) {
   for (std::size_t k = 0; k < ten.size(); ++k) EXPECT_EQ(ten[k].pose.x(), all[k].pose.x());
 }
 
+// Poses absurdly far away (a map in the wrong units) are still places, without overflow.
+TEST(PoseVotes, FarPosesAreCountedToo) {
+  PoseVotes v;
+  v.add(Pose2(3e11, -4e11, 0.1));
+  v.add(Pose2(3e11, -4e11, 0.1));
+  v.add(Pose2(1e300, 2.5, 0.1));
+  v.add(Pose2(1.0, 2.5, 0.1));
+  const auto best = v.best(10);
+  ASSERT_EQ(best.size(), 3u);
+  EXPECT_EQ(best[0].votes, 2);
+  EXPECT_EQ(best[0].pose.x(), 3e11);
+}
+
 TEST(PoseVotes, NoVotesNoPlaces) {
   PoseVotes v;
   EXPECT_TRUE(v.best(10).empty());
