@@ -121,6 +121,9 @@ int run_node(NodeArgs& a) {
   ro.semi_axis = robot.semi_axis;
   if (a.no_ceiling || !robot.find_camera("ceiling_camera")) ro.topics.ceiling_image.clear();
   if (a.no_omni || !robot.find_camera("omni_camera")) ro.topics.omni_image.clear();
+  for (auto [name, size] :
+       {std::pair{"ceiling_camera", &ro.ceiling_size}, std::pair{"omni_camera", &ro.omni_size}})
+    if (const CameraDescription* c = robot.find_camera(name)) *size = {c->width, c->height};
   if (!start && ro.topics.omni_image.empty())
     throw InputError({"", "option", "--initial-pose"},
                      "no starting pose and no omni camera to find the robot with");

@@ -4,7 +4,9 @@
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/ekf.hpp"
+#include "lampnav/io/image_encoding.hpp"
 #include "lampnav/io/mission_log.hpp"
+#include "task_thread.hpp"
 
 namespace lampnav::ros {
 
@@ -20,6 +22,32 @@ std::string image_type(const std::string& topic) {
 }
 
 constexpr std::size_t kOdomKept = 400;  // wheel readings (4 s at 100 Hz) for map -> odom
+
+// Starts a camera's decoding thread and, when its image size is known, has it decode frames of
+// that size as JPEG and as PNG: the codecs' first use (OpenCV registers them, libjpeg and zlib
+// set up) took 10 ms on this machine, and each of the first few frames' pixels went to fresh
+// pages. Three frames are held at once, as many as are in flight at a time (one decoded, one
+// waiting in the queue, one being processed), so that their memory is there for the images.
+std::unique_ptr<detail::TaskThread> decoding_thread(ImageSize size) {
+  auto t = std::make_unique<detail::TaskThread>();
+  if (size.width <= 0 || size.height <= 0) return t;
+  Image8 frame(size.width, size.height);
+  for (int y = 0; y < size.height; ++y)
+    for (int x = 0; x < size.width; ++x)
+      frame.pixels[static_cast<std::size_t>(y) * size.width + x] =
+          static_cast<std::uint8_t>((x * 7 + y * 13) % 256);
+  io::ImageEncoding jpeg;
+  jpeg.format = io::ImageEncoding::Format::jpeg;
+  jpeg.jpeg_quality = 90;
+  io::ImageEncoding png;
+  png.format = io::ImageEncoding::Format::png;
+  std::vector<std::string> bytes = {io::encode_image(frame, jpeg), io::encode_image(frame, png)};
+  t->submit([bytes = std::move(bytes)] {
+     std::vector<Image8> held;
+     for (int k = 0; k < 3; ++k) held.push_back(io::decode_image(bytes[k % 2], "a warm-up frame"));
+   }).get();
+  return t;
+}
 
 }  // namespace
 
@@ -38,6 +66,10 @@ void RosRobotOptions::validate() const {
   if (!(idle_exit_s >= 0)) bad("idle-exit", "must not be negative");
   if (frames.map.empty() || frames.odom.empty() || frames.base.empty())
     bad("frames", "frame ids must not be empty");
+  for (const ImageSize& s : {ceiling_size, omni_size})
+    if (s.width < 0 || s.height < 0 || s.width > 8192 || s.height > 8192 ||
+        (s.width == 0) != (s.height == 0))
+      bad("image size", "a camera's width and height must both be 1 to 8192 px, or both 0");
 }
 
 RosRobot::RosRobot(Participant& p, const RosRobotOptions& options)
@@ -50,6 +82,8 @@ RosRobot::RosRobot(Participant& p, const RosRobotOptions& options)
   mode_ = &p.writer(t.ns + "/mode", "std_msgs/msg/String", Qos::state);
   hypotheses_ = &p.writer(t.ns + "/hypotheses", "geometry_msgs/msg/PoseArray", Qos::state);
   events_ = &p.writer(t.ns + "/events", "std_msgs/msg/String", Qos::state);
+  if (!t.ceiling_image.empty()) ceiling_decoder_ = decoding_thread(o_.ceiling_size);
+  if (!t.omni_image.empty()) omni_decoder_ = decoding_thread(o_.omni_size);
   if (!t.ceiling_image.empty())
     subscribe(p, t.ceiling_image, image_type(t.ceiling_image), Qos::sensor_data, Kind::ceiling);
   if (!t.omni_image.empty())
@@ -68,9 +102,10 @@ void RosRobot::subscribe(Participant& p, const std::string& topic, const std::st
   p.subscribe(topic, type, qos, [this, kind](Sample&& s) {
     Pending pending{kind, std::move(s), {}};
     if (kind == Kind::ceiling || kind == Kind::omni)
-      pending.image = std::async(
-          std::launch::async,
-          [this, kind, cdr = std::move(pending.sample.cdr)] { return decode_image(kind, cdr); });
+      pending.image = (kind == Kind::ceiling ? ceiling_decoder_ : omni_decoder_)
+                          ->submit([this, kind, cdr = std::move(pending.sample.cdr)] {
+                            return decode_image(kind, cdr);
+                          });
     {
       std::lock_guard<std::mutex> lock(mutex_);
       ++counts_of(kind).received;

@@ -2,11 +2,14 @@
 // domain: its inputs in, a damaged message refused with the topic and field while the next one
 // is taken, wheel speeds out as a Twist, an estimate out as the pose and map -> odom.
 
+#include <atomic>
 #include <mutex>
 #include <thread>
 
 #include "cdr.hpp"
 #include "cdr_writer.hpp"
+#include "lampnav/io/image_encoding.hpp"
+#include "lampnav/io/mission_log.hpp"
 #include "lampnav/io/ros2_messages.hpp"
 #include "lampnav/ros/ros_robot.hpp"
 #include "lampnav_test.hpp"
@@ -158,6 +161,68 @@ TEST(RosRobot, RefusesOptionsThatCannotWork) {
   o.topics.joint_states.clear();
   o.topics.odometry = "odom";  // not a ROS 2 topic name
   EXPECT_THROW(RosRobot(p, o), InputError);
+  o.topics.odometry = "/odom";
+  o.omni_size = {1024, 0};  // a width without a height
+  EXPECT_THROW(RosRobot(p, o), InputError);
+  o.omni_size = {-1, -1};
+  EXPECT_THROW(RosRobot(p, o), InputError);
+  o.omni_size = {9000, 9000};  // more than a frame lampnav decodes
+  EXPECT_THROW(RosRobot(p, o), InputError);
+}
+
+// Compressed images, decoded on the camera's own thread after it decoded frames of the camera's
+// size at start: each comes out as its bytes decode, in arrival order; a damaged one is reported
+// with its topic and number and the next one taken.
+TEST(RosRobot, DecodesCompressedImagesOnTheCamerasThread) {
+  const int domain = test::test_domain();
+  Participant node_side(domain), drivers(domain);
+  RosRobotOptions o;
+  o.semi_axis = 0.2;
+  o.topics.ceiling_image = "/ceiling_camera/image_raw/compressed";
+  o.topics.omni_image.clear();
+  o.ceiling_size = {64, 48};
+  RosRobot robot(node_side, o);
+  std::vector<std::string> problems;
+  robot.on_problem = [&](const std::string& p) { problems.push_back(p); };
+  Writer& camera =
+      drivers.writer(o.topics.ceiling_image, "sensor_msgs/msg/CompressedImage", Qos::sensor_data);
+  ASSERT_TRUE(test::wait_for([&] { return camera.matched(); }));
+
+  Image8 lamp(64, 48, 12);
+  for (int y = 20; y < 28; ++y)
+    for (int x = 10; x < 40; ++x) lamp.at(x, y) = 250;
+  io::ImageEncoding jpeg, png;
+  png.format = io::ImageEncoding::Format::png;
+  const std::string jpeg_bytes = io::encode_image(lamp, jpeg);
+  const std::string png_bytes = io::encode_image(lamp, png);
+  const std::vector<std::string> sent = {
+      io::ros2::compressed_image_message(at(1), "ceiling_camera", "jpeg", jpeg_bytes),
+      io::ros2::compressed_image_message(at(2), "ceiling_camera", "jpeg", "not an image"),
+      io::ros2::compressed_image_message(at(3), "ceiling_camera", "png", png_bytes)};
+  for (const std::string& cdr : sent) ASSERT_TRUE(camera.write(cdr));
+
+  std::vector<FrameInput> frames;
+  std::atomic<bool> done{false};
+  std::thread stopper([&] {  // gives up after 5 s
+    for (int k = 0; k < 100 && !done; ++k)
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    robot.stop();
+  });
+  while (frames.size() < 2) {
+    auto in = robot.next();
+    if (!in) break;
+    if (auto* f = std::get_if<FrameInput>(&*in)) frames.push_back(std::move(*f));
+  }
+  done = true;
+  stopper.join();
+  ASSERT_EQ(frames.size(), 2u) << "the images did not come";
+  EXPECT_EQ(frames[0].capture, at(1));
+  EXPECT_EQ(frames[1].capture, at(3));
+  EXPECT_EQ(frames[0].image.pixels, io::decode_image(jpeg_bytes, "jpeg").pixels);
+  EXPECT_EQ(frames[1].image.pixels, lamp.pixels);  // PNG keeps every pixel
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_THAT(problems[0], HasSubstr("/ceiling_camera/image_raw/compressed, message 2"));
+  EXPECT_EQ(robot.counts().ceiling.refused, 1u);
 }
 
 }  // namespace

@@ -2,15 +2,16 @@
 // A robot on a ROS 2 system, behind lampnav::Robot: camera images, wheel odometry (or wheel
 // joint states) and route commands come in over DDS; wheel speeds go out as a Twist on /cmd_vel,
 // and the localizer's estimates as the pose, the map -> odom transform, the mode and the
-// hypotheses (docs/ros2.md). Messages are queued by the DDS threads as bytes and decoded on the
-// caller's thread in next(); one that does not decode is counted and reported (topic, message
-// number, field), never fatal.
+// hypotheses (docs/ros2.md). Messages are queued by the DDS threads as bytes; images are decoded
+// as they arrive on their camera's own thread, the rest on the caller's thread in next(). One
+// that does not decode is counted and reported (topic, message number, field), never fatal.
 
 #include <atomic>
 #include <condition_variable>
 #include <deque>
 #include <functional>
 #include <future>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -22,6 +23,10 @@
 #include "lampnav/ros/participant.hpp"
 
 namespace lampnav::ros {
+
+namespace detail {
+class TaskThread;
+}
 
 struct NodeTopics {
   // Images: sensor_msgs/msg/CompressedImage when the name ends in /compressed (image_transport's
@@ -44,10 +49,19 @@ struct NodeFrames {
   std::string map = "map", odom = "odom", base = "base_link";
 };
 
+// A camera's image size in pixels (robot.json); 0 by 0: not known.
+struct ImageSize {
+  int width = 0, height = 0;
+};
+
 struct RosRobotOptions {
   NodeTopics topics;
   NodeFrames frames;
-  double semi_axis = 0;           // m, from robot.json: odometry poses to wheel travel
+  double semi_axis = 0;  // m, from robot.json: odometry poses to wheel travel
+  // Each camera's images are decoded on a thread of their own. Given the camera's size, that
+  // thread decodes frames of it (JPEG and PNG) before the node subscribes, so that the first
+  // images do not wait for the codecs' first use and for fresh memory (docs/ros2.md, "Latency").
+  ImageSize ceiling_size, omni_size;
   std::size_t max_queue = 10000;  // messages waiting to be processed; beyond, the oldest image goes
   double idle_exit_s = 0;         // > 0: next() ends after this long with no input, once one came
   void validate() const;          // throws InputError naming the option
@@ -90,8 +104,9 @@ class RosRobot : public Robot {
 
  private:
   enum class Kind { ceiling, omni, odometry, joints, command };
-  // An image decoded (CDR, then PNG or JPEG) on a thread of its own as soon as it arrives, so the
-  // loop never waits for one image's decoding while it could process another input.
+  // An image decoded (CDR, then PNG or JPEG) as soon as it arrives, on its camera's decoding
+  // thread, so the loop never waits for one image's decoding while it could process another
+  // input.
   struct DecodedImage {
     Stamp capture;
     Image8 image;
@@ -130,6 +145,10 @@ class RosRobot : public Robot {
   std::optional<fusion::LocalizerMode> last_mode_;
   std::size_t last_hypotheses_ = 0;
   double last_leader_weight_ = -1;
+
+  // Each camera's decoding thread (null when the camera has no topic). Last: destroyed first,
+  // each finishing the images queued to it while the rest of the robot is still there.
+  std::unique_ptr<detail::TaskThread> ceiling_decoder_, omni_decoder_;
 };
 
 }  // namespace lampnav::ros
