@@ -1,6 +1,9 @@
 #include "lampnav/ros/ros_robot.hpp"
 
 #include <cmath>
+#include <condition_variable>
+#include <future>
+#include <mutex>
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/ekf.hpp"
@@ -51,6 +54,74 @@ std::unique_ptr<detail::TaskThread> decoding_thread(ImageSize size) {
 
 }  // namespace
 
+namespace detail {
+
+enum class InputKind : int { ceiling, omni, odometry, joints, command };
+
+// An image decoded (CDR, then PNG or JPEG) as soon as it arrives, on its camera's decoding
+// thread, so the loop never waits for one image's decoding while it could process another input.
+struct DecodedImage {
+  Stamp capture;
+  Image8 image;
+  std::string problem;
+};
+
+struct Pending {
+  InputKind kind;
+  Sample sample;  // its bytes moved to the decoder for images
+  std::future<DecodedImage> image;
+};
+
+struct Inbox {
+  std::mutex mutex;
+  std::condition_variable ready;
+  std::deque<Pending> queue;
+  NodeCounts counts;
+  bool closed = false;  // the robot is gone: what comes is dropped
+  std::unique_ptr<TaskThread> ceiling_decoder, omni_decoder;
+
+  InputCounts& counts_of(InputKind kind) {
+    switch (kind) {
+      case InputKind::ceiling:
+        return counts.ceiling;
+      case InputKind::omni:
+        return counts.omni;
+      case InputKind::command:
+        return counts.commands;
+      default:
+        return counts.odometry;
+    }
+  }
+};
+
+namespace {
+
+// On a camera's decoding thread: touches nothing of the robot's.
+DecodedImage decode_image(const std::string& topic, const std::string& cdr) {
+  DecodedImage d;
+  try {
+    if (image_type(topic) == "sensor_msgs/msg/Image") {
+      io::ros2::GreyImage g = io::ros2::raw_image_grey(cdr);
+      d.capture = g.stamp;
+      d.image = std::move(g.image);
+    } else {
+      const io::ImageFrame f = io::ros2::compressed_image(cdr);
+      d.capture = f.stamp;
+      d.image = io::decode_image(f.data, topic);
+    }
+  } catch (const io::CdrError& e) {
+    d.problem = e.what();
+  } catch (const InputError& e) {
+    d.problem = e.message();
+  }
+  return d;
+}
+
+}  // namespace
+}  // namespace detail
+
+using detail::InputKind;
+
 void RosRobotOptions::validate() const {
   auto bad = [](const char* field, const std::string& why) {
     throw InputError({"", "node options", field}, why);
@@ -82,72 +153,87 @@ RosRobot::RosRobot(Participant& p, const RosRobotOptions& options)
   mode_ = &p.writer(t.ns + "/mode", "std_msgs/msg/String", Qos::state);
   hypotheses_ = &p.writer(t.ns + "/hypotheses", "geometry_msgs/msg/PoseArray", Qos::state);
   events_ = &p.writer(t.ns + "/events", "std_msgs/msg/String", Qos::state);
-  if (!t.ceiling_image.empty()) ceiling_decoder_ = decoding_thread(o_.ceiling_size);
-  if (!t.omni_image.empty()) omni_decoder_ = decoding_thread(o_.omni_size);
-  if (!t.ceiling_image.empty())
-    subscribe(p, t.ceiling_image, image_type(t.ceiling_image), Qos::sensor_data, Kind::ceiling);
-  if (!t.omni_image.empty())
-    subscribe(p, t.omni_image, image_type(t.omni_image), Qos::sensor_data, Kind::omni);
-  if (!t.joint_states.empty())
-    subscribe(p, t.joint_states, "sensor_msgs/msg/JointState", Qos::sensor_data, Kind::joints);
-  else
-    subscribe(p, t.odometry, "nav_msgs/msg/Odometry", Qos::sensor_data, Kind::odometry);
-  subscribe(p, t.command, "std_msgs/msg/String", Qos::state, Kind::command);
-}
-
-RosRobot::~RosRobot() { stop(); }
-
-void RosRobot::subscribe(Participant& p, const std::string& topic, const std::string& type, Qos qos,
-                         Kind kind) {
-  p.subscribe(topic, type, qos, [this, kind](Sample&& s) {
-    Pending pending{kind, std::move(s), {}};
-    if (kind == Kind::ceiling || kind == Kind::omni)
-      pending.image = (kind == Kind::ceiling ? ceiling_decoder_ : omni_decoder_)
-                          ->submit([this, kind, cdr = std::move(pending.sample.cdr)] {
-                            return decode_image(kind, cdr);
-                          });
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      ++counts_of(kind).received;
-      queue_.push_back(std::move(pending));
-      if (queue_.size() > o_.max_queue) {
-        // Behind by more than the queue holds: an old image goes first (odometry and commands
-        // are small and each one counts).
-        for (auto it = queue_.begin(); it != queue_.end(); ++it)
-          if (it->kind == Kind::ceiling || it->kind == Kind::omni) {
-            ++counts_of(it->kind).dropped;
-            queue_.erase(it);
-            break;
-          }
-      }
-    }
-    ready_.notify_one();
-  });
-}
-
-InputCounts& RosRobot::counts_of(Kind kind) {
-  switch (kind) {
-    case Kind::ceiling:
-      return counts_.ceiling;
-    case Kind::omni:
-      return counts_.omni;
-    case Kind::command:
-      return counts_.commands;
-    default:
-      return counts_.odometry;
+  inbox_ = std::make_shared<detail::Inbox>();
+  if (!t.ceiling_image.empty()) inbox_->ceiling_decoder = decoding_thread(o_.ceiling_size);
+  if (!t.omni_image.empty()) inbox_->omni_decoder = decoding_thread(o_.omni_size);
+  try {
+    if (!t.ceiling_image.empty())
+      subscribe(p, t.ceiling_image, image_type(t.ceiling_image), Qos::sensor_data,
+                InputKind::ceiling);
+    if (!t.omni_image.empty())
+      subscribe(p, t.omni_image, image_type(t.omni_image), Qos::sensor_data, InputKind::omni);
+    if (!t.joint_states.empty())
+      subscribe(p, t.joint_states, "sensor_msgs/msg/JointState", Qos::sensor_data,
+                InputKind::joints);
+    else
+      subscribe(p, t.odometry, "nav_msgs/msg/Odometry", Qos::sensor_data, InputKind::odometry);
+    subscribe(p, t.command, "std_msgs/msg/String", Qos::state, InputKind::command);
+  } catch (...) {
+    close();  // the subscriptions made so far stay with the participant
+    throw;
   }
 }
 
-const std::string& RosRobot::topic_of(Kind kind) const {
+RosRobot::~RosRobot() {
+  stop();
+  close();
+}
+
+void RosRobot::close() {
+  std::unique_ptr<detail::TaskThread> ceiling, omni;
+  {
+    std::lock_guard<std::mutex> lock(inbox_->mutex);
+    inbox_->closed = true;
+    inbox_->queue.clear();
+    ceiling = std::move(inbox_->ceiling_decoder);
+    omni = std::move(inbox_->omni_decoder);
+  }
+  // Joined here, outside the lock: the images queued to them are decoded and dropped.
+}
+
+void RosRobot::subscribe(Participant& p, const std::string& topic, const std::string& type, Qos qos,
+                         InputKind kind) {
+  // The callback holds the inbox, never the robot.
+  p.subscribe(topic, type, qos,
+              [inbox = inbox_, kind, topic, max_queue = o_.max_queue](Sample&& s) {
+                {
+                  std::lock_guard<std::mutex> lock(inbox->mutex);
+                  if (inbox->closed) return;
+                  detail::Pending pending{kind, std::move(s), {}};
+                  if (kind == InputKind::ceiling || kind == InputKind::omni)
+                    pending.image =
+                        (kind == InputKind::ceiling ? inbox->ceiling_decoder : inbox->omni_decoder)
+                            ->submit([topic, cdr = std::move(pending.sample.cdr)] {
+                              return detail::decode_image(topic, cdr);
+                            });
+                  ++inbox->counts_of(kind).received;
+                  std::deque<detail::Pending>& queue = inbox->queue;
+                  queue.push_back(std::move(pending));
+                  if (queue.size() > max_queue) {
+                    // Behind by more than the queue holds: an old image goes first (odometry
+                    // and commands are small and each one counts).
+                    for (auto it = queue.begin(); it != queue.end(); ++it)
+                      if (it->kind == InputKind::ceiling || it->kind == InputKind::omni) {
+                        ++inbox->counts_of(it->kind).dropped;
+                        queue.erase(it);
+                        break;
+                      }
+                  }
+                }
+                inbox->ready.notify_one();
+              });
+}
+
+const std::string& RosRobot::topic_of(InputKind kind) const {
   const NodeTopics& t = o_.topics;
   switch (kind) {
-    case Kind::ceiling:
+    case InputKind::ceiling:
       return t.ceiling_image;
-    case Kind::omni:
+    case InputKind::omni:
       return t.omni_image;
-    case Kind::odometry:
+    case InputKind::odometry:
       return t.odometry;
-    case Kind::joints:
+    case InputKind::joints:
       return t.joint_states;
     default:
       return t.command;
@@ -155,13 +241,13 @@ const std::string& RosRobot::topic_of(Kind kind) const {
 }
 
 NodeCounts RosRobot::counts() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  return counts_;
+  std::lock_guard<std::mutex> lock(inbox_->mutex);
+  return inbox_->counts;
 }
 
 void RosRobot::stop() {
   stop_ = true;
-  ready_.notify_all();
+  inbox_->ready.notify_all();
 }
 
 void RosRobot::set_wheel_speeds(double left, double right) {
@@ -170,19 +256,19 @@ void RosRobot::set_wheel_speeds(double left, double right) {
 
 std::optional<RobotInput> RosRobot::next() {
   for (;;) {
-    Pending p;
+    detail::Pending p;
     {
-      std::unique_lock<std::mutex> lock(mutex_);
+      std::unique_lock<std::mutex> lock(inbox_->mutex);
       for (;;) {
         if (stop_) return std::nullopt;
-        if (!queue_.empty()) break;
+        if (!inbox_->queue.empty()) break;
         if (o_.idle_exit_s > 0 && any_input_ &&
             Clock::now() - last_input_ > std::chrono::duration<double>(o_.idle_exit_s))
           return std::nullopt;
-        ready_.wait_for(lock, std::chrono::milliseconds(20));
+        inbox_->ready.wait_for(lock, std::chrono::milliseconds(20));
       }
-      p = std::move(queue_.front());
-      queue_.pop_front();
+      p = std::move(inbox_->queue.front());
+      inbox_->queue.pop_front();
     }
     any_input_ = true;
     last_input_ = Clock::now();
@@ -196,8 +282,8 @@ std::optional<RobotInput> RosRobot::next() {
     } catch (const InputError& e) {
       problem = e.message();
     }
-    std::lock_guard<std::mutex> lock(mutex_);
-    InputCounts& c = counts_of(p.kind);
+    std::lock_guard<std::mutex> lock(inbox_->mutex);
+    InputCounts& c = inbox_->counts_of(p.kind);
     if (!problem.empty()) {
       ++c.refused;
       if (on_problem)
@@ -212,15 +298,15 @@ std::optional<RobotInput> RosRobot::next() {
   }
 }
 
-std::optional<RobotInput> RosRobot::decode(Pending& p) {
+std::optional<RobotInput> RosRobot::decode(detail::Pending& p) {
   const std::string& cdr = p.sample.cdr;
   switch (p.kind) {
-    case Kind::ceiling:
-    case Kind::omni: {
-      DecodedImage d = p.image.get();
+    case InputKind::ceiling:
+    case InputKind::omni: {
+      detail::DecodedImage d = p.image.get();
       if (!d.problem.empty()) throw io::CdrError(d.problem);
       FrameInput in;
-      in.camera = p.kind == Kind::ceiling ? CameraRole::ceiling : CameraRole::omni;
+      in.camera = p.kind == InputKind::ceiling ? CameraRole::ceiling : CameraRole::omni;
       in.capture = d.capture;
       // Robot time: the newest wheel reading, or the capture when it is later.
       in.arrival =
@@ -228,7 +314,7 @@ std::optional<RobotInput> RosRobot::decode(Pending& p) {
       in.image = std::move(d.image);
       return in;
     }
-    case Kind::odometry: {
+    case InputKind::odometry: {
       const io::OdometryPose o = io::ros2::odometry(cdr);
       const auto w = odometry_wheels_.add(o);
       if (!w) return std::nullopt;
@@ -237,7 +323,7 @@ std::optional<RobotInput> RosRobot::decode(Pending& p) {
       if (odom_.size() > kOdomKept) odom_.pop_front();
       return WheelInput{w->stamp, w->left, w->right};
     }
-    case Kind::joints: {
+    case InputKind::joints: {
       const io::WheelJoints j =
           io::ros2::wheel_joints(cdr, o_.topics.left_joint, o_.topics.right_joint);
       const auto w = joint_wheels_.add(j);
@@ -256,31 +342,10 @@ std::optional<RobotInput> RosRobot::decode(Pending& p) {
       last_wheel_stamp_ = w->stamp;
       return *last_wheels_;
     }
-    case Kind::command:
+    case InputKind::command:
       return CommandInput{last_wheel_stamp_.value_or(Stamp{}), io::ros2::string_data(cdr)};
   }
   return std::nullopt;
-}
-
-RosRobot::DecodedImage RosRobot::decode_image(Kind kind, const std::string& cdr) const {
-  DecodedImage d;
-  try {
-    const std::string& topic = topic_of(kind);
-    if (image_type(topic) == "sensor_msgs/msg/Image") {
-      io::ros2::GreyImage g = io::ros2::raw_image_grey(cdr);
-      d.capture = g.stamp;
-      d.image = std::move(g.image);
-    } else {
-      const io::ImageFrame f = io::ros2::compressed_image(cdr);
-      d.capture = f.stamp;
-      d.image = io::decode_image(f.data, topic);
-    }
-  } catch (const io::CdrError& e) {
-    d.problem = e.what();
-  } catch (const InputError& e) {
-    d.problem = e.message();
-  }
-  return d;
 }
 
 void RosRobot::publish(const fusion::LocalizerEstimate& e) {
@@ -296,8 +361,8 @@ void RosRobot::publish(const fusion::LocalizerEstimate& e) {
       }
     if (at)
       tf_->write(io::ros2::tf_message({{e.stamp, f.map, f.odom, e.pose * at->second.inverse()}}));
-    std::lock_guard<std::mutex> lock(mutex_);
-    ++counts_.poses_published;
+    std::lock_guard<std::mutex> lock(inbox_->mutex);
+    ++inbox_->counts.poses_published;
   }
   if (!last_mode_ || *last_mode_ != e.mode) {
     mode_->write(io::ros2::string_message(fusion::to_string(e.mode)));

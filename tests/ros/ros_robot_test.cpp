@@ -151,6 +151,60 @@ TEST(RosRobot, TakesInputsRefusesDamagedOnesAndPublishes) {
   EXPECT_EQ(robot.counts().poses_published, 1u);
 }
 
+// The participant outlives the robot (it was made first), and DDS calls the robot's callbacks
+// until the participant goes: a robot destroyed while its camera and wheels keep publishing must
+// not be called after it is gone (the sanitized suite catches a use after free), nor lose the
+// images its decoding thread held.
+TEST(RosRobot, GoesWhileItsInputsKeepComing) {
+  const int domain = test::test_domain();
+  Participant drivers(domain);
+  Writer& odom = drivers.writer("/odom", "nav_msgs/msg/Odometry", Qos::sensor_data);
+  Writer& camera =
+      drivers.writer("/ceiling_camera/image_raw", "sensor_msgs/msg/Image", Qos::sensor_data);
+  std::atomic<bool> publishing{true};
+  std::thread driver([&] {
+    for (int k = 0; publishing; ++k) {
+      odom.write(
+          io::ros2::odometry_message(at(0.01 * k), "odom", "base_link", Pose2(0.01 * k, 0, 0)));
+      camera.write(test::mono8_image_cdr(to_nanoseconds(at(0.01 * k)), "ceiling_camera", 64, 48, 64,
+                                         std::string(64 * 48, '\x20')));
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+  });
+  for (int round = 0; round < 2; ++round) {
+    Participant node_side(domain);
+    int frames = 0, wheels = 0;
+    {
+      RosRobotOptions o;
+      o.semi_axis = 0.2;
+      o.topics.ceiling_image = "/ceiling_camera/image_raw";
+      o.topics.omni_image.clear();
+      o.ceiling_size = {64, 48};
+      RosRobot robot(node_side, o);
+      std::atomic<bool> done{false};
+      std::thread stopper([&] {  // gives up after 10 s
+        for (int k = 0; k < 200 && !done; ++k)
+          std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        robot.stop();
+      });
+      while (frames < 20 || wheels < 20) {
+        auto in = robot.next();
+        if (!in) break;
+        frames += std::holds_alternative<FrameInput>(*in);
+        wheels += std::holds_alternative<WheelInput>(*in);
+      }
+      done = true;
+      stopper.join();
+    }  // gone while the inputs keep coming
+    EXPECT_GE(frames, 20) << "round " << round;
+    EXPECT_GE(wheels, 20) << "round " << round;
+    std::this_thread::sleep_for(
+        std::chrono::milliseconds(200));  // the participant still hears them
+  }
+  publishing = false;
+  driver.join();
+}
+
 TEST(RosRobot, RefusesOptionsThatCannotWork) {
   Participant p(test::test_domain());
   RosRobotOptions o;

@@ -7,12 +7,9 @@
 // that does not decode is counted and reported (topic, message number, field), never fatal.
 
 #include <atomic>
-#include <condition_variable>
 #include <deque>
 #include <functional>
-#include <future>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,8 +22,10 @@
 namespace lampnav::ros {
 
 namespace detail {
-class TaskThread;
-}
+enum class InputKind : int;
+struct Inbox;
+struct Pending;
+}  // namespace detail
 
 struct NodeTopics {
   // Images: sensor_msgs/msg/CompressedImage when the name ends in /compressed (image_transport's
@@ -103,34 +102,19 @@ class RosRobot : public Robot {
   std::function<void(const std::string&)> on_problem;
 
  private:
-  enum class Kind { ceiling, omni, odometry, joints, command };
-  // An image decoded (CDR, then PNG or JPEG) as soon as it arrives, on its camera's decoding
-  // thread, so the loop never waits for one image's decoding while it could process another
-  // input.
-  struct DecodedImage {
-    Stamp capture;
-    Image8 image;
-    std::string problem;
-  };
-  struct Pending {
-    Kind kind;
-    Sample sample;  // its bytes moved to the decoder for images
-    std::future<DecodedImage> image;
-  };
-  DecodedImage decode_image(Kind kind, const std::string& cdr) const;
+  std::optional<RobotInput> decode(detail::Pending& p);
   void subscribe(Participant& p, const std::string& topic, const std::string& type, Qos qos,
-                 Kind kind);
-  std::optional<RobotInput> decode(Pending& p);
-  InputCounts& counts_of(Kind kind);
-  const std::string& topic_of(Kind kind) const;
+                 detail::InputKind kind);
+  const std::string& topic_of(detail::InputKind kind) const;
+  // Closes the inbox: its callbacks drop what comes from then on; the decoding threads finish.
+  void close();
 
   RosRobotOptions o_;
   Writer *cmd_vel_, *pose_, *tf_, *mode_, *hypotheses_, *events_;
-
-  mutable std::mutex mutex_;
-  std::condition_variable ready_;
-  std::deque<Pending> queue_;
-  NodeCounts counts_;
+  // What the DDS threads hand over (the queue, the counts, each camera's decoding thread), shared
+  // with the participant's callbacks: the participant may call them after the robot is gone (it
+  // outlives the robot), and they then find the inbox closed and drop the message.
+  std::shared_ptr<detail::Inbox> inbox_;
   std::atomic<bool> stop_{false};
 
   // The loop thread's own.
@@ -145,10 +129,6 @@ class RosRobot : public Robot {
   std::optional<fusion::LocalizerMode> last_mode_;
   std::size_t last_hypotheses_ = 0;
   double last_leader_weight_ = -1;
-
-  // Each camera's decoding thread (null when the camera has no topic). Last: destroyed first,
-  // each finishing the images queued to it while the rest of the robot is still there.
-  std::unique_ptr<detail::TaskThread> ceiling_decoder_, omni_decoder_;
 };
 
 }  // namespace lampnav::ros
