@@ -25,7 +25,6 @@ class PoseVotes {
   static constexpr double kCellDeg = 3.0;
 
   void add(const Pose2& pose) { poses_.push_back(pose); }
-  std::size_t size() const { return poses_.size(); }
 
   struct Place {
     int votes = 0;
