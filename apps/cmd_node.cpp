@@ -141,8 +141,21 @@ int run_node(NodeArgs& a) {
   std::signal(SIGTERM, on_signal);
   std::atomic<bool> done{false};
   std::thread watcher([&] {
-    while (!done) {
+    ros::NodeCounts reported;
+    for (int tick = 1; !done; ++tick) {
       if (g_stop) ros_robot.stop();
+      if (!a.quiet && tick % 100 == 0) {  // every 5 s: images dropped since the last report
+        const ros::NodeCounts c = ros_robot.counts();
+        const std::uint64_t ceiling = c.ceiling.dropped - reported.ceiling.dropped,
+                            omni = c.omni.dropped - reported.omni.dropped;
+        if (ceiling + omni > 0)
+          diagnostic("warning", std::to_string(ceiling) + " ceiling and " + std::to_string(omni) +
+                                    " omni images dropped in the last 5 s: the node processes "
+                                    "them more slowly than the cameras send them, and keeps "
+                                    "each camera's newest " +
+                                    std::to_string(ro.max_images_waiting));
+        reported = c;
+      }
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
   });
@@ -184,6 +197,9 @@ int run_node(NodeArgs& a) {
             << " poses published; image in to pose out: ceiling p50 " << ceiling_ms["p50"]
             << " ms, p99 " << ceiling_ms["p99"] << " ms; omni p50 " << omni_ms["p50"] << " ms, p99 "
             << omni_ms["p99"] << " ms";
+  if (c.ceiling.dropped + c.omni.dropped > 0)
+    std::cout << "; images dropped, the node behind its cameras: " << c.ceiling.dropped
+              << " ceiling, " << c.omni.dropped << " omni";
   if (!pub.searching_us[1].empty())
     std::cout << "; omni image in to hypotheses out while searching (" << omni_searching_ms["n"]
               << " frames): max " << omni_searching_ms["max"] << " ms";

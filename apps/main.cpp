@@ -19,7 +19,8 @@
 
 namespace lampnav::apps {
 void diagnostic(const std::string& kind, const std::string& text) {
-  std::cerr << "lampnav: " << kind << ": " << text << "\n";
+  // One write, so that lines from the node's threads do not interleave.
+  std::cerr << ("lampnav: " + kind + ": " + text + "\n");
 }
 
 std::string data_path(const std::string& relative) {

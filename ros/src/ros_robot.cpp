@@ -1,5 +1,6 @@
 #include "lampnav/ros/ros_robot.hpp"
 
+#include <atomic>
 #include <cmath>
 #include <condition_variable>
 #include <future>
@@ -70,6 +71,10 @@ struct Pending {
   InputKind kind;
   Sample sample;  // its bytes moved to the decoder for images
   std::future<DecodedImage> image;
+  // An image's: set when it is dropped, so that its decoding is skipped if not yet begun.
+  std::shared_ptr<std::atomic<bool>> dropped;
+
+  bool is_image() const { return kind == InputKind::ceiling || kind == InputKind::omni; }
 };
 
 struct Inbox {
@@ -79,6 +84,24 @@ struct Inbox {
   NodeCounts counts;
   bool closed = false;  // the robot is gone: what comes is dropped
   std::unique_ptr<TaskThread> ceiling_decoder, omni_decoder;
+  // Each camera's images in the queue (not yet taken by next()).
+  std::size_t ceiling_waiting = 0, omni_waiting = 0;
+
+  std::size_t& waiting(InputKind kind) {
+    return kind == InputKind::ceiling ? ceiling_waiting : omni_waiting;
+  }
+  // Drops the oldest image in the queue (of `kind`, or of either camera): counted, and not
+  // decoded if its decoding has not begun. The caller holds the mutex.
+  void drop_oldest_image(std::optional<InputKind> kind) {
+    for (auto it = queue.begin(); it != queue.end(); ++it)
+      if (it->is_image() && (!kind || it->kind == *kind)) {
+        *it->dropped = true;
+        ++counts_of(it->kind).dropped;
+        --waiting(it->kind);
+        queue.erase(it);
+        return;
+      }
+  }
 
   InputCounts& counts_of(InputKind kind) {
     switch (kind) {
@@ -134,6 +157,7 @@ void RosRobotOptions::validate() const {
   if (topics.ceiling_image.empty() && topics.omni_image.empty())
     bad("ceiling-topic", "neither camera has a topic");
   if (max_queue < 10) bad("max_queue", "must be at least 10");
+  if (max_images_waiting < 1) bad("max_images_waiting", "must be at least 1");
   if (!(idle_exit_s >= 0)) bad("idle-exit", "must not be negative");
   if (frames.map.empty() || frames.odom.empty() || frames.base.empty())
     bad("frames", "frame ids must not be empty");
@@ -184,41 +208,47 @@ void RosRobot::close() {
   {
     std::lock_guard<std::mutex> lock(inbox_->mutex);
     inbox_->closed = true;
+    for (detail::Pending& p : inbox_->queue)
+      if (p.dropped) *p.dropped = true;
     inbox_->queue.clear();
     ceiling = std::move(inbox_->ceiling_decoder);
     omni = std::move(inbox_->omni_decoder);
   }
-  // Joined here, outside the lock: the images queued to them are decoded and dropped.
+  // Joined here, outside the lock: the images queued to them whose decoding began are decoded
+  // and dropped, the others skipped.
 }
 
 void RosRobot::subscribe(Participant& p, const std::string& topic, const std::string& type, Qos qos,
                          InputKind kind) {
   // The callback holds the inbox, never the robot.
   p.subscribe(topic, type, qos,
-              [inbox = inbox_, kind, topic, max_queue = o_.max_queue](Sample&& s) {
+              [inbox = inbox_, kind, topic, max_queue = o_.max_queue,
+               max_images = o_.max_images_waiting](Sample&& s) {
                 {
                   std::lock_guard<std::mutex> lock(inbox->mutex);
                   if (inbox->closed) return;
-                  detail::Pending pending{kind, std::move(s), {}};
-                  if (kind == InputKind::ceiling || kind == InputKind::omni)
+                  detail::Pending pending{kind, std::move(s), {}, {}};
+                  if (pending.is_image()) {
+                    auto dropped = std::make_shared<std::atomic<bool>>(false);
+                    pending.dropped = dropped;
                     pending.image =
                         (kind == InputKind::ceiling ? inbox->ceiling_decoder : inbox->omni_decoder)
-                            ->submit([topic, cdr = std::move(pending.sample.cdr)] {
+                            ->submit([topic, cdr = std::move(pending.sample.cdr), dropped] {
+                              // Dropped while it waited for the decoder: not decoded.
+                              if (*dropped) return detail::DecodedImage{};
                               return detail::decode_image(topic, cdr);
                             });
-                  ++inbox->counts_of(kind).received;
-                  std::deque<detail::Pending>& queue = inbox->queue;
-                  queue.push_back(std::move(pending));
-                  if (queue.size() > max_queue) {
-                    // Behind by more than the queue holds: an old image goes first (odometry
-                    // and commands are small and each one counts).
-                    for (auto it = queue.begin(); it != queue.end(); ++it)
-                      if (it->kind == InputKind::ceiling || it->kind == InputKind::omni) {
-                        ++inbox->counts_of(it->kind).dropped;
-                        queue.erase(it);
-                        break;
-                      }
                   }
+                  ++inbox->counts_of(kind).received;
+                  inbox->queue.push_back(std::move(pending));
+                  // A camera whose images come faster than they are processed has its oldest
+                  // waiting image dropped, so that what is processed stays recent and the
+                  // queue's memory bounded (ROS 2's sensor-data QoS keeps the last five too).
+                  if (kind == InputKind::ceiling || kind == InputKind::omni)
+                    if (++inbox->waiting(kind) > max_images) inbox->drop_oldest_image(kind);
+                  // Behind by more than the queue holds: an old image goes first (odometry and
+                  // commands are small and each one counts).
+                  if (inbox->queue.size() > max_queue) inbox->drop_oldest_image(std::nullopt);
                 }
                 inbox->ready.notify_one();
               });
@@ -269,6 +299,7 @@ std::optional<RobotInput> RosRobot::next() {
       }
       p = std::move(inbox_->queue.front());
       inbox_->queue.pop_front();
+      if (p.is_image()) --inbox_->waiting(p.kind);
     }
     any_input_ = true;
     last_input_ = Clock::now();

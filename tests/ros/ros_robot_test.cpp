@@ -242,6 +242,51 @@ TEST(RosRobot, RefusesOptionsThatCannotWork) {
   EXPECT_THROW(RosRobot(p, o), InputError);
   o.omni_size = {9000, 9000};  // more than a frame lampnav decodes
   EXPECT_THROW(RosRobot(p, o), InputError);
+  o.omni_size = {};
+  o.max_images_waiting = 0;  // every image dropped
+  EXPECT_THROW(RosRobot(p, o), InputError);
+}
+
+// A camera faster than the node: while nothing is taken, each image past the five waiting drops
+// the camera's oldest, so that the node then processes the five newest and no backlog; the wheel
+// readings are all kept. (With the queue alone bounding it, all 30 images waited.)
+TEST(RosRobot, KeepsTheNewestImagesWhenItFallsBehind) {
+  const int domain = test::test_domain();
+  Participant node_side(domain), drivers(domain);
+  const RosRobotOptions o = ceiling_camera_only("/ceiling_camera/image_raw");
+  ASSERT_EQ(o.max_images_waiting, 5u);
+  RosRobot robot(node_side, o);
+  Writer& odom = drivers.writer("/odom", "nav_msgs/msg/Odometry", Qos::sensor_data);
+  Writer& camera =
+      drivers.writer(o.topics.ceiling_image, "sensor_msgs/msg/Image", Qos::sensor_data);
+  ASSERT_TRUE(test::wait_for([&] { return camera.matched() && odom.matched(); }));
+  const int sent = 30;
+  for (int k = 0; k < sent; ++k) {
+    ASSERT_TRUE(odom.write(
+        io::ros2::odometry_message(at(0.1 * k), "odom", "base_link", Pose2(0.01 * k, 0, 0))));
+    ASSERT_TRUE(camera.write(test::mono8_image_cdr(to_nanoseconds(at(0.1 * k)), "ceiling_camera",
+                                                   64, 48, 64, std::string(64 * 48, char(k)))));
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ASSERT_TRUE(test::wait_for([&] {
+    const NodeCounts c = robot.counts();
+    return c.ceiling.received == std::size_t(sent) && c.odometry.received == std::size_t(sent);
+  })) << "the driver's messages did not all come";
+  EXPECT_EQ(robot.counts().ceiling.dropped, std::size_t(sent) - 5);
+
+  const Taken taken = take_inputs(
+      robot, [&](const Taken& t) { return t.frames.size() >= 5 && t.wheels.size() >= 30; });
+  ASSERT_EQ(taken.frames.size(), 5u);
+  for (int k = 0; k < 5; ++k) {
+    const int n = sent - 5 + k;
+    EXPECT_EQ(taken.frames[k].capture, at(0.1 * n));
+    EXPECT_EQ(taken.frames[k].image.pixels[0], std::uint8_t(n)) << "frame " << k;
+  }
+  EXPECT_EQ(taken.wheels.size(), std::size_t(sent));
+  const NodeCounts c = robot.counts();
+  EXPECT_EQ(c.ceiling.used, 5u);
+  EXPECT_EQ(c.ceiling.dropped, std::size_t(sent) - 5);
+  EXPECT_EQ(c.odometry.dropped, 0u);
 }
 
 // Compressed images, decoded on the camera's own thread after it decoded frames of the camera's

@@ -62,8 +62,13 @@ struct RosRobotOptions {
   // images do not wait for the codecs' first use and for fresh memory (docs/ros2.md, "Latency").
   ImageSize ceiling_size, omni_size;
   std::size_t max_queue = 10000;  // messages waiting to be processed; beyond, the oldest image goes
-  double idle_exit_s = 0;         // > 0: next() ends after this long with no input, once one came
-  void validate() const;          // throws InputError naming the option
+  // Each camera's images waiting to be processed (decoding or decoded, not yet taken by next());
+  // beyond, that camera's oldest waiting image is dropped (counted; not decoded unless its
+  // decoding began). A node slower than its cameras then processes recent images, a bounded
+  // time after they came, instead of falling further behind (docs/ros2.md, "Falling behind").
+  std::size_t max_images_waiting = 5;
+  double idle_exit_s = 0;  // > 0: next() ends after this long with no input, once one came
+  void validate() const;   // throws InputError naming the option
 };
 
 struct InputCounts {
