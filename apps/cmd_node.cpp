@@ -261,6 +261,11 @@ void add_node_command(CLI::App& app, Job& run) {
   c->add_option("--idle-exit", a->robot_options.idle_exit_s,
                 "end after this many seconds with no input, once input came (s)")
       ->check(CLI::NonNegativeNumber);
+  c->add_option("--images-waiting", a->robot_options.max_images_waiting,
+                "each camera's images kept waiting while the node is behind; beyond, its oldest "
+                "waiting image is dropped")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
   c->add_option("--stats", a->stats, "write counts and latencies here (JSON) on exit");
   c->add_flag("--quiet", a->quiet, "no notes on stderr");
   c->callback([a, &run] { run = [a] { return run_node(*a); }; });
