@@ -85,12 +85,13 @@ void GlobalLocalizer::Impl::pair_poses(const Seeds& s, std::size_t j, std::size_
 
 namespace {
 // The cell of a pose in the exhaustive search, which keeps one pose a cell: 0.25 m x 3 degrees.
+// Unsigned, from clamped floors: a map far from its origin wraps the key, never overflows it.
 std::int64_t cell_of(const Pose2& p) {
   const double cell_m = 0.25, cell_rad = 3 * kDeg;
-  return (std::int64_t(std::floor(p.x() / cell_m)) * 1000003 +
-          std::int64_t(std::floor(p.y() / cell_m))) *
-             1009 +
-         std::int64_t(std::floor((p.yaw() + M_PI) / cell_rad));
+  auto index = [](double v) { return static_cast<std::uint64_t>(detail::clamped_floor(v)); };
+  return static_cast<std::int64_t>((index(p.x() / cell_m) * 1000003u + index(p.y() / cell_m)) *
+                                       1009u +
+                                   index((p.yaw() + M_PI) / cell_rad));
 }
 std::string too_few_seeds(std::size_t n, const LampPairOptions& q) {
   return std::to_string(n) + " lamp(s) within " + std::to_string(int(q.pair_max_theta_deg)) +

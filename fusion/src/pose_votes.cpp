@@ -12,9 +12,6 @@ constexpr int kGrids = 8;
 constexpr double kCellRad = PoseVotes::kCellDeg * M_PI / 180;
 constexpr std::int64_t kTurn = 120;  // yaw cells in a turn: 360 / 3 degrees
 
-// floor(v) as an integer, clamped first so that no coordinate converts out of range.
-std::int64_t whole(double v) { return std::int64_t(std::floor(std::clamp(v, -1e15, 1e15))); }
-
 // Two places within a cell of each other along every axis: one place.
 bool same_place(const Pose2& a, const Pose2& b) {
   return std::abs(a.x() - b.x()) < PoseVotes::kCellM &&
@@ -28,8 +25,8 @@ class Distinct {
  public:
   // Whether p is a place not seen yet; if so it is kept.
   bool insert(const Pose2& p) {
-    const std::int64_t ix = whole(p.x() / PoseVotes::kCellM);
-    const std::int64_t iy = whole(p.y() / PoseVotes::kCellM);
+    const std::int64_t ix = clamped_floor(p.x() / PoseVotes::kCellM);
+    const std::int64_t iy = clamped_floor(p.y() / PoseVotes::kCellM);
     for (std::int64_t dx = -1; dx <= 1; ++dx)
       for (std::int64_t dy = -1; dy <= 1; ++dy) {
         const auto it = squares_.find(key(ix + dx, iy + dy));
@@ -97,8 +94,8 @@ void PoseVotes::count() {
   std::vector<Halves> halves(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Pose2& p = poses_[i];
-    halves[i] = {whole(2 * p.x() / kCellM), whole(2 * p.y() / kCellM),
-                 whole(2 * (p.yaw() + M_PI) / kCellRad)};
+    halves[i] = {clamped_floor(2 * p.x() / kCellM), clamped_floor(2 * p.y() / kCellM),
+                 clamped_floor(2 * (p.yaw() + M_PI) / kCellRad)};
   }
   std::size_t capacity = 16;
   while (capacity < 2 * n) capacity *= 2;
@@ -115,8 +112,7 @@ void PoseVotes::count() {
     for (std::size_t i = 0; i < n; ++i) {
       const Halves& p = halves[i];
       const std::int64_t a = half_down(p.a + sa);
-      // Unsigned: a map thousands of kilometres across wraps the key instead of overflowing it
-      // (the same key as signed arithmetic gives wherever that does not overflow).
+      // Unsigned (clamped_floor).
       const std::uint64_t u =
           ((std::uint64_t(half_down(p.x + sx)) * 1000003u + std::uint64_t(half_down(p.y + sy))) *
                1009u +

@@ -7,6 +7,8 @@
 // along each of x, y and yaw: poses that agree to within half a cell share a cell in one of them
 // whatever their place against the borders, and a place is as many votes as its best cell holds.
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -14,6 +16,14 @@
 #include "lampnav/core/pose2.hpp"
 
 namespace lampnav::fusion::detail {
+
+// floor(v) as an integer, clamped first so that no coordinate converts out of range (NaN: 0).
+// Cells' keys are built from these in unsigned arithmetic: a map thousands of kilometres across
+// wraps a key instead of overflowing it (the same key as signed arithmetic gives wherever that
+// does not overflow).
+inline std::int64_t clamped_floor(double v) {
+  return v == v ? std::int64_t(std::floor(std::clamp(v, -1e15, 1e15))) : 0;
+}
 
 class PoseVotes {
  public:

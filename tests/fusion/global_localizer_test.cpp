@@ -4,6 +4,8 @@
 
 #include <random>
 
+#include <nlohmann/json.hpp>
+
 #include "lampnav/core/error.hpp"
 #include "lampnav/fusion/global_localizer.hpp"
 #include "lampnav/fusion/merit.hpp"
@@ -350,6 +352,43 @@ TEST(GlobalLocalizer, BadImagesGiveNoHypothesisAndSayWhy) {
   // An image of another size is refused by the detector, naming it.
   Image8 small(640, 480, 1);
   EXPECT_THROW(detector.detect(vision::ImageView::of(small)), InputError);
+}
+
+// A map whose frame's origin is absurdly far off (10 million km east: a map in the wrong units,
+// or a frame mistaken): its search's cells of 0.25 m made keys past what a signed 64-bit integer
+// holds, which overflowed (undefined behaviour: the sanitized suite stops on it). The map loads,
+// so the robot must be found there as near the origin.
+TEST(GlobalLocalizer, SearchesAMapFarFromItsOrigin) {
+  const Museum m;
+  const double east = 1e10;
+  nlohmann::json j = nlohmann::json::parse(m.geojson);
+  std::function<void(nlohmann::json&)> shift = [&](nlohmann::json& v) {
+    if (v.is_array() && v.size() >= 2 && v[0].is_number() && v[1].is_number()) {
+      v[0] = v[0].get<double>() + east;  // a point: x first
+      return;
+    }
+    if (v.is_object()) {
+      for (auto& [key, value] : v.items()) {
+        if (key == "x_values")
+          for (auto& x : value) x = x.get<double>() + east;
+        else if (key != "y_values")
+          shift(value);
+      }
+    } else if (v.is_array()) {
+      for (auto& e : v) shift(e);
+    }
+  };
+  shift(j);
+  const graph::TopologicalMap far = graph::parse_map(j.dump(), "far.geojson").map;
+  const GlobalLocalizer global(far, m.omni_camera());
+  const Pose2 truth(5.9 + 0.3 + east, -2.0 - 0.2, 0.7);
+  const vision::OmniDetection d = test::clean_omni_view(m.omni_camera(), far, truth, 3);
+  const GlobalLocalization voted = global.locate(d);             // the most voted places
+  const GlobalLocalization every = global.enumerate(d, 64, 20);  // every place the image allows
+  for (const GlobalLocalization* r : {&voted, &every}) {
+    ASSERT_TRUE(r->found()) << r->why;
+    EXPECT_LT((r->hypotheses.front().pose.translation() - truth.translation()).norm(), 0.05);
+  }
 }
 
 }  // namespace
