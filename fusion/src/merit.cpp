@@ -29,10 +29,14 @@ CeilingMapProjection::CeilingMapProjection(const graph::TopologicalMap& map,
   for (const auto& n : map.nodes())
     for (const auto& l : n.lamps) {
       lamps_.push_back(&l);
-      lx_.push_back(float(l.xyz.x()));
-      ly_.push_back(float(l.xyz.y()));
-      lz_.push_back(float(l.xyz.z()));
+      origin_ += l.xyz.head<2>();
     }
+  if (!lamps_.empty()) origin_ /= double(lamps_.size());
+  for (const graph::Lamp* l : lamps_) {
+    lx_.push_back(float(l->xyz.x() - origin_.x()));
+    ly_.push_back(float(l->xyz.y() - origin_.y()));
+    lz_.push_back(float(l->xyz.z()));
+  }
   // g(s) = r / t with t = tan(theta / 2) and s = t^2: smooth, finite on the axis, so that a
   // pixel needs one square root and one division: r / rho = g(s) / (n + z).
   t_max_ = std::tan(model.max_theta() / 2);
@@ -59,8 +63,9 @@ void CeilingMapProjection::project(const Pose2& robot, std::vector<Vector2d>& pi
   Eigen::Matrix3d Rz_t;
   Rz_t << c, s, 0, -s, c, 0, 0, 0, 1;
   const Eigen::Matrix3d R = mount_Rt_ * Rz_t;
-  const Vector3d C(robot.x() + c * mount_t_.x() - s * mount_t_.y(),
-                   robot.y() + s * mount_t_.x() + c * mount_t_.y(), mount_t_.z());
+  // (Relative to the lamps' mean, as they are kept.)
+  const Vector3d C(robot.x() - origin_.x() + c * mount_t_.x() - s * mount_t_.y(),
+                   robot.y() - origin_.y() + s * mount_t_.x() + c * mount_t_.y(), mount_t_.z());
   const Vector3d RC = R * C;
   // Single precision from here: a pixel to 1e-4 px, and twice the square roots per cycle.
   const float r00 = float(R(0, 0)), r01 = float(R(0, 1)), r02 = float(R(0, 2));

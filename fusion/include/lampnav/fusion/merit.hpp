@@ -31,8 +31,11 @@ class CeilingMapProjection {
 
  private:
   std::vector<const graph::Lamp*> lamps_;
-  std::vector<float> lx_, ly_, lz_;  // lamp centres, single precision
-  Eigen::Matrix3d mount_Rt_;         // base -> camera
+  // Lamp centres in single precision, relative to the lamps' mean (a map far from its origin
+  // keeps its precision: a float 5,000 km out is 0.5 m from the next).
+  Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
+  std::vector<float> lx_, ly_, lz_;
+  Eigen::Matrix3d mount_Rt_;  // base -> camera
   Eigen::Vector3d mount_t_;
   double u0_, v0_, beta_;
   int width_, height_;
