@@ -228,7 +228,8 @@ void RosRobot::subscribe(Participant& p, const std::string& topic, const std::st
                   std::lock_guard<std::mutex> lock(inbox->mutex);
                   if (inbox->closed) return;
                   detail::Pending pending{kind, std::move(s), {}, {}};
-                  if (pending.is_image()) {
+                  const bool image = pending.is_image();
+                  if (image) {
                     auto dropped = std::make_shared<std::atomic<bool>>(false);
                     pending.dropped = dropped;
                     pending.image =
@@ -244,8 +245,7 @@ void RosRobot::subscribe(Participant& p, const std::string& topic, const std::st
                   // A camera whose images come faster than they are processed has its oldest
                   // waiting image dropped, so that what is processed stays recent and the
                   // queue's memory bounded (ROS 2's sensor-data QoS keeps the last five too).
-                  if (kind == InputKind::ceiling || kind == InputKind::omni)
-                    if (++inbox->waiting(kind) > max_images) inbox->drop_oldest_image(kind);
+                  if (image && ++inbox->waiting(kind) > max_images) inbox->drop_oldest_image(kind);
                   // Behind by more than the queue holds: an old image goes first (odometry and
                   // commands are small and each one counts).
                   if (inbox->queue.size() > max_queue) inbox->drop_oldest_image(std::nullopt);
