@@ -1,5 +1,7 @@
 #include "lampnav/io/ros2_messages.hpp"
 
+#include <Eigen/Eigenvalues>
+
 #include <cmath>
 
 #include "cdr.hpp"
@@ -135,6 +137,38 @@ OdometryPose odometry(const std::string& data) {
   const double yaw = std::atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz));
   o.pose = Pose2(x, y, yaw);
   return o;
+}
+
+PoseEstimate pose_estimate(const std::string& data) {
+  CdrReader r(data);
+  PoseEstimate e;
+  const Header h = header(r);
+  e.stamp = h.stamp;
+  e.frame_id = h.frame_id;
+  const double x = r.f64("pose.pose.position.x"), y = r.f64("pose.pose.position.y");
+  r.f64("pose.pose.position.z");
+  const double qx = r.f64("pose.pose.orientation.x"), qy = r.f64("pose.pose.orientation.y"),
+               qz = r.f64("pose.pose.orientation.z"), qw = r.f64("pose.pose.orientation.w");
+  double c[36];
+  for (double& v : c) v = r.f64("pose.covariance");
+  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(qx) || !std::isfinite(qy) ||
+      !std::isfinite(qz) || !std::isfinite(qw))
+    throw CdrError("pose.pose is not finite");
+  if (std::abs(std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw) - 1) > 0.01)
+    throw CdrError("pose.pose.orientation is not a unit quaternion");
+  e.pose = Pose2(x, y, std::atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz)));
+  // Row-major 6 x 6 over (x, y, z, roll, pitch, yaw): the planar part.
+  constexpr int kAt[3] = {0, 1, 5};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) e.covariance(i, j) = c[6 * kAt[i] + kAt[j]];
+  const Eigen::Matrix3d& P = e.covariance;
+  if (!P.allFinite() || !P.isApprox(P.transpose(), 1e-9) ||
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(P, Eigen::EigenvaluesOnly).eigenvalues()(0) <=
+          0)
+    throw CdrError(
+        "pose.covariance: the x, y and yaw block must be symmetric positive definite (RViz sends "
+        "variances of 0.25 m^2, 0.25 m^2 and 0.0685 rad^2)");
+  return e;
 }
 
 // sensor_msgs/msg/JointState: the positions of the two wheel joints, found by name.

@@ -107,7 +107,7 @@ void image(const std::uint8_t* data, std::size_t size) {
 void ros2_cdr(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return;
   const std::string in = text(data + 1, size - 1);
-  switch (data[0] % 8) {
+  switch (data[0] % 9) {
     case 0:
       contract([&] { return io::ros2::compressed_image(in); },
                [](const io::ImageFrame& f) {
@@ -156,6 +156,16 @@ void ros2_cdr(const std::uint8_t* data, std::size_t size) {
       break;
     case 6:
       contract([&] { return io::ros2::tf_transforms(in); }, [](const auto&) {});
+      break;
+    case 8:
+      contract([&] { return io::ros2::pose_estimate(in); },
+               [](const io::ros2::PoseEstimate& e) {
+                 const auto again = io::ros2::pose_estimate(io::ros2::pose_with_covariance_stamped(
+                     e.stamp, e.frame_id, e.pose, e.covariance));
+                 if (again.stamp != e.stamp || again.pose.x() != e.pose.x() ||
+                     again.pose.y() != e.pose.y() || again.covariance != e.covariance)
+                   broken("pose estimate written and read again differs");
+               });
       break;
     default:
       contract([&] { return io::ros2::raw_image(in); }, [](const io::ImageFrame&) {});

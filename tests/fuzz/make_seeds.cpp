@@ -171,6 +171,9 @@ int main(int argc, char** argv) {
   cdr(5, "string", io::ros2::string_message("follow the corridor"));
   cdr(6, "tf", io::ros2::tf_message({{t, "base_link", "cam", Pose2(0.1, 0.2, 0.3)}}));
   cdr(7, "raw_image_mono16", raw.data());
+  cdr(8, "pose_estimate",
+      io::ros2::pose_with_covariance_stamped(t, "map", Pose2(3.5, -1.25, 0.4),
+                                             Eigen::Vector3d(0.25, 0.25, 0.0685).asDiagonal()));
 
   // Images.
   put("image", "tiny.png", io::encode_png(tiny(12, 10)));

@@ -188,6 +188,38 @@ TEST(RosWire, WhatTheNodeWritesItsDecodersRead) {
   }
 }
 
+// geometry_msgs/msg/PoseWithCovarianceStamped read back as written (the encoder is checked byte
+// for byte against ROS 2's tooling above); a covariance that is not symmetric positive definite
+// over (x, y, yaw), or a message cut short anywhere, is refused naming the field.
+TEST(RosWire, PoseEstimatesReadAsWrittenOrRefused) {
+  const Stamp t = stamp_from_nanoseconds(42'000'000'001);
+  Eigen::Matrix3d c;
+  c << 0.3, 0.01, 0.002, 0.01, 0.2, 0.003, 0.002, 0.003, 0.05;
+  const std::string full =
+      io::ros2::pose_with_covariance_stamped(t, "map", Pose2(-4.5, 8.25, -2.75), c);
+  const io::ros2::PoseEstimate e = io::ros2::pose_estimate(full);
+  EXPECT_EQ(e.stamp, t);
+  EXPECT_EQ(e.frame_id, "map");
+  EXPECT_NEAR(e.pose.x(), -4.5, 1e-15);
+  EXPECT_NEAR(e.pose.y(), 8.25, 1e-15);
+  EXPECT_NEAR(e.pose.yaw(), -2.75, 1e-12);
+  EXPECT_EQ(e.covariance, c);
+  for (std::size_t n = 0; n < full.size(); ++n)
+    EXPECT_THROW(io::ros2::pose_estimate(full.substr(0, n)), io::CdrError) << n;
+  Eigen::Matrix3d bad = c;
+  bad(2, 2) = -0.05;  // a negative variance
+  Eigen::Matrix3d lopsided = c;
+  lopsided(0, 1) = 0.2;  // not symmetric
+  for (const Eigen::Matrix3d& m : {bad, lopsided, Eigen::Matrix3d::Zero().eval()}) {
+    try {
+      io::ros2::pose_estimate(io::ros2::pose_with_covariance_stamped(t, "map", Pose2(), m));
+      ADD_FAILURE() << "taken:\n" << m;
+    } catch (const io::CdrError& err) {
+      EXPECT_THAT(err.what(), ::testing::HasSubstr("pose.covariance"));
+    }
+  }
+}
+
 // Wheel travel from odometry and joints, one reading at a time, as bags and the node take them.
 TEST(RosWire, WheelTravelFromOdometryAndJoints) {
   io::ros2::OdometryWheels odo(0.2);

@@ -50,6 +50,17 @@ CameraInfo camera_info(const std::string& cdr);
 std::string string_data(const std::string& cdr);
 // tf2_msgs/msg/TFMessage (from /tf or /tf_static).
 std::vector<FrameTransform> tf_transforms(const std::string& cdr);
+// geometry_msgs/msg/PoseWithCovarianceStamped, as RViz's and Foxglove's "2D Pose Estimate"
+// publish on /initialpose: the planar pose and its covariance over (x, y, yaw). Refused when not
+// finite, when the orientation is not a unit quaternion, or when the (x, y, yaw) covariance is
+// not symmetric positive definite (a pose given as certain is not one lampnav may take).
+struct PoseEstimate {
+  Stamp stamp;
+  std::string frame_id;
+  Pose2 pose;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+};
+PoseEstimate pose_estimate(const std::string& cdr);
 
 // --- Encoders (little endian, as ROS 2 writes on x86 and ARM) ---
 
