@@ -6,7 +6,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <csignal>
+#include <cstdio>
 #include <iostream>
 #include <memory>
 #include <thread>
@@ -81,6 +83,19 @@ struct Publisher : navigation::RuntimeObserver {
     if (!quiet) diagnostic("note", text);
     last_mission.clear();
   }
+  void on_pose_estimate(const PoseInput& p, const std::string& why) override {
+    char at[96];
+    std::snprintf(at, sizeof at, "(%.2f, %.2f) facing %.0f deg", p.pose.x(), p.pose.y(),
+                  p.pose.yaw() * 180 / M_PI);
+    const std::string text = why.empty()
+                                 ? std::string("pose estimate taken: the robot at ") + at
+                                 : std::string("pose estimate at ") + at + " refused: " + why;
+    robot->publish_event(text);
+    // The pose goes out now, as a fix (relocalized) for the cameras to confirm.
+    const fusion::LocalizerEstimate e = runtime->localizer().estimate();
+    if (runtime->localizer().initialized() || !e.hypotheses.empty()) robot->publish(e);
+    if (!quiet) diagnostic("note", text);
+  }
   // The mission's end, once.
   void mission_news() {
     const navigation::Executor& x = runtime->executor();
@@ -124,9 +139,10 @@ int run_node(NodeArgs& a) {
   for (auto [name, size] :
        {std::pair{"ceiling_camera", &ro.ceiling_size}, std::pair{"omni_camera", &ro.omni_size}})
     if (const CameraDescription* c = robot.find_camera(name)) *size = {c->width, c->height};
-  if (!start && ro.topics.omni_image.empty())
+  if (!start && ro.topics.omni_image.empty() && ro.topics.pose_estimate.empty())
     throw InputError({"", "option", "--initial-pose"},
-                     "no starting pose and no omni camera to find the robot with");
+                     "no starting pose, no omni camera to find the robot with, and no pose "
+                     "estimate topic to be told on");
   ro.validate();
   const int domain = a.domain >= 0 ? a.domain : ros::domain_from_environment();
 
@@ -165,7 +181,11 @@ int run_node(NodeArgs& a) {
                    (ro.topics.ceiling_image.empty() ? "" : ro.topics.ceiling_image + ", ") +
                    (ro.topics.omni_image.empty() ? "" : ro.topics.omni_image + ", ") +
                    (ro.topics.joint_states.empty() ? ro.topics.odometry : ro.topics.joint_states) +
-                   ", " + ro.topics.command);
+                   ", " + ro.topics.command +
+                   (ro.topics.pose_estimate.empty() ? "" : ", " + ro.topics.pose_estimate));
+  if (!a.quiet && !start && ro.topics.omni_image.empty())
+    diagnostic("note", "no starting pose and no omni camera: waiting for a pose estimate on " +
+                           ro.topics.pose_estimate);
   Publisher pub;
   pub.robot = &ros_robot;
   pub.runtime = &runtime;
@@ -211,6 +231,7 @@ int run_node(NodeArgs& a) {
         {"omni", counts_json(c.omni)},
         {"odometry", counts_json(c.odometry)},
         {"commands", counts_json(c.commands)},
+        {"pose_estimates", counts_json(c.pose_estimates)},
         {"wheel_readings", out.wheel_readings},
         {"ceiling_frames", out.ceiling_frames},
         {"omni_frames", out.omni_frames},
@@ -251,6 +272,10 @@ void add_node_command(CLI::App& app, Job& run) {
   c->add_option("--right-joint", t.right_joint, "the right wheel's joint (default: named right)");
   c->add_option("--wheel-radius", t.wheel_radius, "with joint states: the wheels' radius (m)")
       ->check(CLI::PositiveNumber);
+  c->add_option("--pose-estimate-topic", t.pose_estimate,
+                "geometry_msgs/msg/PoseWithCovarianceStamped in the map frame: an operator's pose "
+                "estimate, taken as a fix (\"\": none)")
+      ->capture_default_str();
   c->add_option("--command-topic", t.command, "std_msgs/msg/String route commands")
       ->capture_default_str();
   c->add_option("--cmd-vel-topic", t.cmd_vel, "geometry_msgs/msg/Twist out")->capture_default_str();

@@ -89,6 +89,19 @@ RunOutcome Runtime::run(Robot& robot, const std::optional<Pose2>& start,
       }
       continue;
     }
+    if (const auto* p = std::get_if<PoseInput>(&*input)) {
+      // The operator's word, as a fix: the cameras confirm it (relocalized, then tracking) or
+      // find the robot elsewhere as after a carry. Before any wheel reading, it starts the filter.
+      if (localizer_.global_fix({p->arrival, p->pose, p->covariance, "an operator's estimate"})) {
+        ++out.pose_estimates;
+        obs.on_pose_estimate(*p, "");
+      } else {
+        obs.on_pose_estimate(*p,
+                             "the filter refused it (its time is before the filter's "
+                             "history, or its covariance is not usable)");
+      }
+      continue;
+    }
     const auto& f = std::get<FrameInput>(*input);
     const vision::ImageView view = vision::ImageView::of(f.image);
     try {

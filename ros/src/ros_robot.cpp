@@ -57,7 +57,7 @@ std::unique_ptr<detail::TaskThread> decoding_thread(ImageSize size) {
 
 namespace detail {
 
-enum class InputKind : int { ceiling, omni, odometry, joints, command };
+enum class InputKind : int { ceiling, omni, odometry, joints, command, pose_estimate };
 
 // An image decoded (CDR, then PNG or JPEG) as soon as it arrives, on its camera's decoding
 // thread, so the loop never waits for one image's decoding while it could process another input.
@@ -111,6 +111,8 @@ struct Inbox {
         return counts.omni;
       case InputKind::command:
         return counts.commands;
+      case InputKind::pose_estimate:
+        return counts.pose_estimates;
       default:
         return counts.odometry;
     }
@@ -192,6 +194,9 @@ RosRobot::RosRobot(Participant& p, const RosRobotOptions& options)
     else
       subscribe(p, t.odometry, "nav_msgs/msg/Odometry", Qos::sensor_data, InputKind::odometry);
     subscribe(p, t.command, "std_msgs/msg/String", Qos::state, InputKind::command);
+    if (!t.pose_estimate.empty())
+      subscribe(p, t.pose_estimate, "geometry_msgs/msg/PoseWithCovarianceStamped", Qos::state,
+                InputKind::pose_estimate);
   } catch (...) {
     close();  // the subscriptions made so far stay with the participant
     throw;
@@ -265,6 +270,8 @@ const std::string& RosRobot::topic_of(InputKind kind) const {
       return t.odometry;
     case InputKind::joints:
       return t.joint_states;
+    case InputKind::pose_estimate:
+      return t.pose_estimate;
     default:
       return t.command;
   }
@@ -375,6 +382,15 @@ std::optional<RobotInput> RosRobot::decode(detail::Pending& p) {
     }
     case InputKind::command:
       return CommandInput{last_wheel_stamp_.value_or(Stamp{}), io::ros2::string_data(cdr)};
+    case InputKind::pose_estimate: {
+      const io::ros2::PoseEstimate e = io::ros2::pose_estimate(cdr);
+      if (e.frame_id != o_.frames.map)
+        throw io::CdrError("header.frame_id is '" + e.frame_id +
+                           "': a pose estimate must be in the '" + o_.frames.map + "' frame");
+      // Where the robot is now: at the newest wheel reading (the estimate's own stamp is the
+      // clock of whatever published it, RViz's or Foxglove's, not necessarily the robot's).
+      return PoseInput{last_wheel_stamp_.value_or(e.stamp), e.pose, e.covariance};
+    }
   }
   return std::nullopt;
 }

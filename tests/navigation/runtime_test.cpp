@@ -63,7 +63,10 @@ class ScriptedRobot : public Robot {
 
 struct Recorder : RuntimeObserver {
   int estimates = 0;
-  std::vector<std::string> refused, commands;
+  std::vector<std::string> refused, commands, pose_estimates;
+  void on_pose_estimate(const PoseInput&, const std::string& why) override {
+    pose_estimates.push_back(why.empty() ? "taken" : why);
+  }
   void on_estimate(const fusion::LocalizerEstimate&) override { ++estimates; }
   void on_refused(const FrameInput&, const std::string& why) override { refused.push_back(why); }
   void on_command(const CommandInput& c, const std::string& why) override {
@@ -129,6 +132,50 @@ TEST(Runtime, RefusesBadOptions) {
   RuntimeOptions bad;
   bad.max_duration_s = -1;
   EXPECT_THROW(Runtime(o.map, o.robot, bad), InputError);
+}
+
+// No start and no camera: the robot is never found and the mission never starts, until an
+// operator says where it is ("2D Pose Estimate"). Then the filter starts there, relocalized (the
+// cameras would confirm it) and the route is driven. A second estimate moves the pose at once.
+TEST(Runtime, AnOperatorsPoseEstimateIsTakenAsAFix) {
+  const Office o;
+  const Pose2 start = o.on_c1(1.0);
+  const Eigen::Matrix3d P = Eigen::Vector3d(0.25, 0.25, 0.0685).asDiagonal();
+  {
+    ScriptedRobot robot(start, o.robot.semi_axis, 5.0);
+    Runtime rt(o.map, o.robot);
+    const RunOutcome out =
+        rt.run(robot, std::nullopt, graph::parse_route_commands("go to Workshop"));
+    EXPECT_EQ(robot.forward(), 0) << "drove without knowing where it was";
+    EXPECT_FALSE(rt.localizer().initialized());
+    EXPECT_EQ(out.pose_estimates, 0u);
+  }
+  ScriptedRobot robot(start, o.robot.semi_axis, 120.0);
+  robot.queue(WheelInput{at(0.98), 0, 0});
+  robot.queue(PoseInput{at(0.98), start, P});
+  Runtime rt(o.map, o.robot);
+  Recorder rec;
+  const RunOutcome out =
+      rt.run(robot, std::nullopt, graph::parse_route_commands("go to Workshop"), &rec);
+  EXPECT_EQ(out.pose_estimates, 1u);
+  ASSERT_EQ(rec.pose_estimates, std::vector<std::string>{"taken"});
+  ASSERT_EQ(out.status, ExecutorStatus::arrived) << out.reason;
+  EXPECT_EQ(rt.localizer().estimate().mode, fusion::LocalizerMode::relocalized);
+  const graph::Node* in = o.map.node_containing(robot.pose().translation());
+  ASSERT_NE(in, nullptr);
+  EXPECT_EQ(in->id, o.map.find_node("Workshop")->id);
+
+  // Tracking, told it is elsewhere: the estimate is there at once.
+  ScriptedRobot moved(start, o.robot.semi_axis, 1.0);
+  const Pose2 there(start.x() + 3.0, start.y(), start.yaw());
+  moved.queue(WheelInput{at(0.98), 0, 0});
+  moved.queue(WheelInput{at(0.99), 0, 0});
+  moved.queue(PoseInput{at(0.99), there, P});
+  Runtime rt2(o.map, o.robot);
+  rt2.run(moved, start, {});
+  const fusion::LocalizerEstimate e = rt2.localizer().estimate();
+  EXPECT_NEAR((e.pose.translation() - there.translation()).norm(), 0.0, 1e-6);
+  EXPECT_EQ(e.mode, fusion::LocalizerMode::relocalized);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 //
 //   lampnav_log_player LOG.mcap --domain D [--rate R] [--wheel-radius M] [--poses OUT]
 //                      [--wait-s S] [--loops N] [--jpeg QUALITY | --raw]
+//                      [--pose-estimate X,Y,YAW]   (sent on /initialpose after the first wheels)
 // Prints one line of counts; exit 0, 1 when no node answered, 2 for bad arguments.
 
 #include <atomic>
@@ -57,6 +58,8 @@ int main(int argc, char** argv) {
       p.writer("/ceiling_camera/image_raw" + suffix, image_type, ros::Qos::sensor_data);
   ros::Writer& omni =
       p.writer("/omni_camera/image_raw" + suffix, image_type, ros::Qos::sensor_data);
+  ros::Writer& estimate =
+      p.writer("/initialpose", "geometry_msgs/msg/PoseWithCovarianceStamped", ros::Qos::state);
   // Raw frames are decoded before playing, as a camera driver hands them over.
   std::vector<Image8> raw_ceiling, raw_omni;
   if (o.raw) {
@@ -82,9 +85,12 @@ int main(int argc, char** argv) {
                 last_pose_ns = s.arrival.time_since_epoch().count();
               });
 
-  // The node must be there before anything is played.
+  // The node must be there before anything is played (its omni reader too, unless the node is
+  // to be told where the robot is: then it may run without the omni camera).
   const auto deadline = Clock::now() + std::chrono::duration<double>(o.wait_s);
-  while (joints.matched() == 0 || ceiling.matched() == 0 || omni.matched() == 0 ||
+  while (joints.matched() == 0 || ceiling.matched() == 0 ||
+         (omni.matched() == 0 && !o.pose_estimate) ||
+         (o.pose_estimate && estimate.matched() == 0) ||
          p.publishers_matched("/lampnav/pose") == 0) {
     if (Clock::now() > deadline) {
       std::cerr << "lampnav_log_player: no node matched in " << o.wait_s << " s\n";
@@ -114,6 +120,10 @@ int main(int argc, char** argv) {
         ok = joints.write(io::ros2::joint_state_message(
             w.stamp + shift, {"left_wheel_joint", "right_wheel_joint"},
             {w.left / o.wheel_radius, w.right / o.wheel_radius}));
+        if (o.pose_estimate && loop == 0 && sent[0] == 0)  // RViz's covariance
+          estimate.write(io::ros2::pose_with_covariance_stamped(
+              w.stamp, "map", *o.pose_estimate,
+              Eigen::Vector3d(0.25, 0.25, 0.06853891945200942).asDiagonal()));
       } else {
         const auto& f = (kind == 1 ? log.ceiling_images : log.omni_images)[it.index].value;
         const char* frame = kind == 1 ? "ceiling_camera" : "omni_camera";

@@ -97,6 +97,66 @@ TEST(Node, PublishesThePosesReplayComputesFromTheSameLog) {
   EXPECT_LE(worst, 1e-3);
 }
 
+// Without a start and without the omni camera the node cannot find the robot; an operator's "2D
+// Pose Estimate" on /initialpose (sent by the player after the first wheel reading, where the
+// robot starts) tells it, and it tracks the drive from there on the ceiling camera alone.
+TEST(Node, TracksFromAnOperatorsPoseEstimate) {
+  const std::string geojson = test::slurp(test::source_path("maps/office_floor.geojson"));
+  const graph::TopologicalMap map = graph::parse_map(geojson, "office_floor.geojson").map;
+  const std::string robot_path = test::source_path("maps/robots/pioneer.json");
+  const RobotDescription robot = read_robot_description(robot_path);
+  const std::string dir = test::temp_path("node_estimate_test");
+  fs::create_directories(dir);
+  const std::string log_path = dir + "/corridor.mcap";
+  sim::record_mission(sim::make_named_scenario("corridor", map, geojson, robot, 1), log_path);
+  const io::MissionLog log = io::read_mission_log(log_path);
+  const io::TruthTrack truth(log.truth);
+  const Pose2 start = truth.at(log.wheels.front().value.stamp);
+
+  const std::string domain = std::to_string(test::test_domain());
+  const std::string node_cmd = std::string(LAMPNAV_BINARY) + " node --robot '" + robot_path +
+                               "' --map '" + test::source_path("maps/office_floor.geojson") +
+                               "' --domain " + domain +
+                               " --no-omni --joint-states-topic /joint_states --wheel-radius 0.1"
+                               " --images-waiting 100000 --idle-exit 3 --quiet --stats '" +
+                               dir + "/stats.json' > '" + dir + "/node.out' 2>&1 &";
+  ASSERT_EQ(std::system(node_cmd.c_str()), 0);
+  char at[96];
+  std::snprintf(at, sizeof at, "%.9f,%.9f,%.9f", start.x(), start.y(), start.yaw());
+  int status = -1;
+  const std::string played =
+      test::run_command(std::string(LAMPNAV_LOG_PLAYER) + " '" + log_path + "' --domain " + domain +
+                            " --rate 3 --wheel-radius 0.1 --pose-estimate " + at + " --poses '" +
+                            dir + "/poses.txt' 2>&1",
+                        &status);
+  ASSERT_EQ(status, 0) << played;
+  std::cout << "player: " << played;
+  ASSERT_TRUE(test::wait_for([&] { return fs::exists(dir + "/stats.json"); }, 30))
+      << test::slurp(dir + "/node.out");
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const nlohmann::json stats = nlohmann::json::parse(test::slurp(dir + "/stats.json"));
+  EXPECT_EQ(stats["pose_estimates"]["used"], 1u);
+  EXPECT_EQ(stats["omni_frames"], 0u);
+
+  std::ifstream in(dir + "/poses.txt");
+  std::string line;
+  std::size_t poses = 0;
+  double worst = 0;
+  while (std::getline(in, line)) {
+    std::istringstream s(line);
+    std::int64_t t;
+    double x, y, yaw;
+    s >> t >> x >> y >> yaw;
+    ++poses;
+    worst = std::max(
+        worst, (truth.at(stamp_from_nanoseconds(t)).translation() - Eigen::Vector2d(x, y)).norm());
+  }
+  fs::remove_all(dir);
+  std::cout << poses << " poses published, at most " << worst * 100 << " cm from the truth\n";
+  EXPECT_GT(poses, 3000u);  // one a wheel reading from the estimate on
+  EXPECT_LT(worst, 0.1);
+}
+
 TEST(Node, RefusesBadOptionsWithStatus2) {
   const std::string base = std::string(LAMPNAV_BINARY) + " node --robot '" +
                            test::source_path("maps/robots/pioneer.json") + "' --map '" +

@@ -3,10 +3,12 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
 #include "cdr.hpp"  // io's CDR reader (white-box)
+#include "lampnav/core/pose2.hpp"
 
 namespace lampnav::test {
 
@@ -16,6 +18,8 @@ struct PlayerOptions {
   int jpeg_quality = 0;  // > 0: images sent as JPEG of this quality (decoded and encoded first)
   bool raw = false;      // images sent as sensor_msgs/msg/Image (mono8), decoded first
   double rate = 1, wheel_radius = 0.1, wait_s = 20, linger_s = 3;
+  // An operator's "2D Pose Estimate" (x, y, yaw) sent on /initialpose after the first wheels.
+  std::optional<Pose2> pose_estimate;
 };
 
 inline PlayerOptions parse_player_options(int argc, char** argv) {
@@ -47,7 +51,13 @@ inline PlayerOptions parse_player_options(int argc, char** argv) {
       o.jpeg_quality = static_cast<int>(number(k));
     else if (a == "--raw")
       o.raw = true;
-    else if (a == "--poses" && k + 1 < argc)
+    else if (a == "--pose-estimate" && k + 1 < argc) {
+      double x = 0, y = 0, yaw = 0;
+      char tail = 0;
+      if (std::sscanf(argv[++k], "%lf,%lf,%lf%c", &x, &y, &yaw, &tail) != 3)
+        throw std::invalid_argument("--pose-estimate: X,Y,YAW");
+      o.pose_estimate = Pose2(x, y, yaw);
+    } else if (a == "--poses" && k + 1 < argc)
       o.poses = argv[++k];
     else if (!a.empty() && a[0] != '-' && o.log.empty())
       o.log = a;

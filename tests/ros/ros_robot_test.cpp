@@ -328,5 +328,52 @@ TEST(RosRobot, DecodesCompressedImagesOnTheCamerasThread) {
   EXPECT_EQ(robot.counts().ceiling.refused, 1u);
 }
 
+// An operator's "2D Pose Estimate" on /initialpose, as RViz sends it (the map frame, its default
+// covariance), comes out as a pose input at the newest wheel reading's time; one in another frame
+// or with a zero covariance is refused naming the topic, the message and the field.
+TEST(RosRobot, TakesAnOperatorsPoseEstimate) {
+  const int domain = test::test_domain();
+  Participant node_side(domain), drivers(domain);
+  RosRobotOptions o = ceiling_camera_only("/ceiling_camera/image_raw");
+  o.idle_exit_s = 0.5;  // next() ends once the messages are all taken
+  RosRobot robot(node_side, o);
+  std::vector<std::string> problems;
+  robot.on_problem = [&](const std::string& p) { problems.push_back(p); };
+  Writer& odom = drivers.writer("/odom", "nav_msgs/msg/Odometry", Qos::sensor_data);
+  Writer& estimate =
+      drivers.writer("/initialpose", "geometry_msgs/msg/PoseWithCovarianceStamped", Qos::state);
+  ASSERT_TRUE(test::wait_for([&] { return odom.matched() && estimate.matched(); }));
+  ASSERT_TRUE(odom.write(io::ros2::odometry_message(at(7), "odom", "base_link", Pose2())));
+  ASSERT_TRUE(test::wait_for([&] { return robot.counts().odometry.received == 1; }));
+  const Eigen::Matrix3d rviz = Eigen::Vector3d(0.25, 0.25, 0.06853891945200942).asDiagonal();
+  const Pose2 there(12.5, -3.25, 1.2);
+  // RViz stamps with its own clock: not the robot's.
+  ASSERT_TRUE(estimate.write(io::ros2::pose_with_covariance_stamped(at(1e6), "map", there, rviz)));
+  ASSERT_TRUE(estimate.write(io::ros2::pose_with_covariance_stamped(at(1e6), "odom", there, rviz)));
+  ASSERT_TRUE(estimate.write(
+      io::ros2::pose_with_covariance_stamped(at(1e6), "map", there, Eigen::Matrix3d::Zero(), 0)));
+  ASSERT_TRUE(test::wait_for([&] { return robot.counts().pose_estimates.received == 3; }));
+  std::vector<PoseInput> poses;
+  std::size_t wheels = 0;
+  while (auto in = robot.next()) {
+    if (std::get_if<WheelInput>(&*in)) ++wheels;
+    if (auto* p = std::get_if<PoseInput>(&*in)) poses.push_back(*p);
+  }
+  EXPECT_EQ(wheels, 1u);
+  ASSERT_EQ(poses.size(), 1u);
+  EXPECT_EQ(poses[0].arrival, at(7));
+  EXPECT_NEAR(poses[0].pose.x(), 12.5, 1e-12);
+  EXPECT_NEAR(poses[0].pose.y(), -3.25, 1e-12);
+  EXPECT_NEAR(poses[0].pose.yaw(), 1.2, 1e-12);
+  EXPECT_EQ(poses[0].covariance, rviz);
+  EXPECT_EQ(robot.counts().pose_estimates.used, 1u);
+  EXPECT_EQ(robot.counts().pose_estimates.refused, 2u);
+  ASSERT_EQ(problems.size(), 2u);
+  EXPECT_THAT(problems[0], HasSubstr("/initialpose, message 2"));
+  EXPECT_THAT(problems[0], HasSubstr("header.frame_id is 'odom'"));
+  EXPECT_THAT(problems[1], HasSubstr("/initialpose, message 3"));
+  EXPECT_THAT(problems[1], HasSubstr("pose.covariance"));
+}
+
 }  // namespace
 }  // namespace lampnav::ros

@@ -1,13 +1,15 @@
 #pragma once
 // The small interface the stack drives a robot through: wheel speeds out; wheel readings, camera
-// frames and route commands in, in the order they arrive. A real robot (the DDS node, ros/), the
-// simulated one (sim/) and a recorded mission (replay) all stand behind it.
+// frames, route commands and an operator's pose estimates in, in the order they arrive. A real
+// robot (the DDS node, ros/), the simulated one (sim/) and a recorded mission (replay) all stand
+// behind it.
 
 #include <optional>
 #include <string>
 #include <variant>
 
 #include "lampnav/core/image.hpp"
+#include "lampnav/core/pose2.hpp"
 #include "lampnav/core/time.hpp"
 
 namespace lampnav {
@@ -33,7 +35,16 @@ struct CommandInput {
   std::string text;
 };
 
-using RobotInput = std::variant<WheelInput, FrameInput, CommandInput>;
+// Where an operator says the robot is (RViz's or Foxglove's "2D Pose Estimate", published on
+// /initialpose): taken as a fix at `arrival`, with its covariance over (x, y, yaw). The cameras
+// then confirm it or, if it is wrong, find the robot as after a carry.
+struct PoseInput {
+  Stamp arrival;
+  Pose2 pose;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Identity();
+};
+
+using RobotInput = std::variant<WheelInput, FrameInput, CommandInput, PoseInput>;
 
 class Robot {
  public:

@@ -42,6 +42,8 @@ class RuntimeObserver {
   virtual void on_input_fault(const InputFault& /*fault*/) {}
   // Route commands given while running: taken (why empty) or refused, with why.
   virtual void on_command(const CommandInput& /*command*/, const std::string& /*why*/) {}
+  // An operator's pose estimate: taken as a fix (why empty) or refused by the filter, with why.
+  virtual void on_pose_estimate(const PoseInput& /*pose*/, const std::string& /*why*/) {}
 };
 
 struct RunOutcome {
@@ -49,6 +51,7 @@ struct RunOutcome {
   std::string reason;                            // why the mission failed
   std::size_t wheel_readings = 0, ceiling_frames = 0, omni_frames = 0, refused_frames = 0;
   std::size_t commands = 0, refused_commands = 0;  // given while running
+  std::size_t pose_estimates = 0;                  // an operator's, taken as fixes
   InputFaultCounts faults[3];                      // by InputStream
   std::optional<Stamp> first, last;                // robot time span
   bool time_limit = false;                         // stopped by max_duration_s

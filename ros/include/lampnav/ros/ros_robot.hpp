@@ -38,7 +38,10 @@ struct NodeTopics {
   std::string joint_states, left_joint, right_joint;
   double wheel_radius = 0;
   std::string command = "/lampnav/command";  // std_msgs/msg/String, route command text
-  std::string cmd_vel = "/cmd_vel";          // geometry_msgs/msg/Twist
+  // geometry_msgs/msg/PoseWithCovarianceStamped in the map frame: an operator's "2D Pose
+  // Estimate" (RViz, Foxglove), taken as a fix. Empty: not subscribed.
+  std::string pose_estimate = "/initialpose";
+  std::string cmd_vel = "/cmd_vel";  // geometry_msgs/msg/Twist
   // Outputs under this namespace: pose, mode, hypotheses, events (and /tf).
   std::string ns = "/lampnav";
 };
@@ -76,7 +79,7 @@ struct InputCounts {
 };
 
 struct NodeCounts {
-  InputCounts ceiling, omni, odometry, commands;
+  InputCounts ceiling, omni, odometry, commands, pose_estimates;
   std::uint64_t poses_published = 0;
 };
 
