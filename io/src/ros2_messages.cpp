@@ -118,24 +118,33 @@ ImageFrame raw_image(const std::string& data) {
   return f;
 }
 
+namespace {
+
+// geometry_msgs/msg/Pose (in `pose.pose`) as a planar pose: finite, its orientation a unit
+// quaternion (1 %), yaw taken from it.
+Pose2 planar_pose(CdrReader& r) {
+  const double x = r.f64("pose.pose.position.x"), y = r.f64("pose.pose.position.y");
+  r.f64("pose.pose.position.z");
+  const double qx = r.f64("pose.pose.orientation.x"), qy = r.f64("pose.pose.orientation.y"),
+               qz = r.f64("pose.pose.orientation.z"), qw = r.f64("pose.pose.orientation.w");
+  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(qx) || !std::isfinite(qy) ||
+      !std::isfinite(qz) || !std::isfinite(qw))
+    throw CdrError("pose.pose is not finite");
+  if (std::abs(std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw) - 1) > 0.01)
+    throw CdrError("pose.pose.orientation is not a unit quaternion");
+  return Pose2(x, y, std::atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz)));
+}
+
+}  // namespace
+
 OdometryPose odometry(const std::string& data) {
   CdrReader r(data);
   OdometryPose o;
   o.stamp = header(r).stamp;
   r.string("child_frame_id");
-  const double x = r.f64("pose.pose.position.x"), y = r.f64("pose.pose.position.y");
-  r.f64("pose.pose.position.z");
-  const double qx = r.f64("pose.pose.orientation.x"), qy = r.f64("pose.pose.orientation.y"),
-               qz = r.f64("pose.pose.orientation.z"), qw = r.f64("pose.pose.orientation.w");
+  o.pose = planar_pose(r);
   for (int k = 0; k < 36; ++k) r.f64("pose.covariance");
   for (int k = 0; k < 6 + 36; ++k) r.f64("twist");
-  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(qx) || !std::isfinite(qy) ||
-      !std::isfinite(qz) || !std::isfinite(qw))
-    throw CdrError("pose is not finite");
-  if (std::abs(std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw) - 1) > 0.01)
-    throw CdrError("pose.pose.orientation is not a unit quaternion");
-  const double yaw = std::atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz));
-  o.pose = Pose2(x, y, yaw);
   return o;
 }
 
@@ -145,18 +154,9 @@ PoseEstimate pose_estimate(const std::string& data) {
   const Header h = header(r);
   e.stamp = h.stamp;
   e.frame_id = h.frame_id;
-  const double x = r.f64("pose.pose.position.x"), y = r.f64("pose.pose.position.y");
-  r.f64("pose.pose.position.z");
-  const double qx = r.f64("pose.pose.orientation.x"), qy = r.f64("pose.pose.orientation.y"),
-               qz = r.f64("pose.pose.orientation.z"), qw = r.f64("pose.pose.orientation.w");
+  e.pose = planar_pose(r);
   double c[36];
   for (double& v : c) v = r.f64("pose.covariance");
-  if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(qx) || !std::isfinite(qy) ||
-      !std::isfinite(qz) || !std::isfinite(qw))
-    throw CdrError("pose.pose is not finite");
-  if (std::abs(std::sqrt(qx * qx + qy * qy + qz * qz + qw * qw) - 1) > 0.01)
-    throw CdrError("pose.pose.orientation is not a unit quaternion");
-  e.pose = Pose2(x, y, std::atan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz)));
   // Row-major 6 x 6 over (x, y, z, roll, pitch, yaw): the planar part.
   constexpr int kAt[3] = {0, 1, 5};
   for (int i = 0; i < 3; ++i)

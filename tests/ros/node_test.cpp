@@ -25,61 +25,85 @@ namespace {
 
 namespace fs = std::filesystem;
 
-TEST(Node, PublishesThePosesReplayComputesFromTheSameLog) {
-  const std::string geojson = test::slurp(test::source_path("maps/office_floor.geojson"));
-  const graph::TopologicalMap map = graph::parse_map(geojson, "office_floor.geojson").map;
-  const std::string robot_path = test::source_path("maps/robots/pioneer.json");
-  const RobotDescription robot = read_robot_description(robot_path);
-  const std::string dir = test::temp_path("node_test");
-  fs::create_directories(dir);
-  const std::string log_path = dir + "/corridor.mcap";
-  sim::record_mission(sim::make_named_scenario("corridor", map, geojson, robot, 1), log_path);
-  const io::MissionLog log = io::read_mission_log(log_path);
-  const evaluation::ReplayResult replayed = evaluation::replay(log, map, robot);
+// The corridor drive recorded, `lampnav node` started on it in the background and the player
+// playing it; what the node wrote (its counts) and what the player heard (its poses).
+struct CorridorRun {
+  std::string geojson = test::slurp(test::source_path("maps/office_floor.geojson"));
+  graph::TopologicalMap map = graph::parse_map(geojson, "office_floor.geojson").map;
+  std::string robot_path = test::source_path("maps/robots/pioneer.json");
+  RobotDescription robot = read_robot_description(robot_path);
+  std::string dir, log_path;
+  io::MissionLog log;
+  std::string domain = std::to_string(test::test_domain());
 
-  const std::string domain = std::to_string(test::test_domain());
-  const std::string node_cmd = std::string(LAMPNAV_BINARY) + " node --robot '" + robot_path +
-                               "' --map '" + test::source_path("maps/office_floor.geojson") +
-                               "' --domain " + domain +
-                               " --joint-states-topic /joint_states --wheel-radius 0.1"
-                               // Every image, as replay takes them, however loaded the
-                               // machine running the tests is.
-                               " --images-waiting 100000"
-                               " --idle-exit 3 --quiet --stats '" +
-                               dir + "/stats.json' > '" + dir + "/node.out' 2>&1 &";
-  ASSERT_EQ(std::system(node_cmd.c_str()), 0);
-  int status = -1;
-  const std::string played =
-      test::run_command(std::string(LAMPNAV_LOG_PLAYER) + " '" + log_path + "' --domain " + domain +
-                            " --rate 2 --wheel-radius 0.1 --poses '" + dir + "/poses.txt' 2>&1",
-                        &status);
-  ASSERT_EQ(status, 0) << played;
-  std::cout << "player: " << played;
-  ASSERT_TRUE(test::wait_for([&] { return fs::exists(dir + "/stats.json"); }, 30))
-      << test::slurp(dir + "/node.out");
-  std::this_thread::sleep_for(
-      std::chrono::milliseconds(500));  // the file is written whole before the node ends
-  std::cout << "node: " << test::slurp(dir + "/node.out");
-  const nlohmann::json stats = nlohmann::json::parse(test::slurp(dir + "/stats.json"));
+  explicit CorridorRun(const std::string& name) : dir(test::temp_path(name)) {
+    fs::create_directories(dir);
+    log_path = dir + "/corridor.mcap";
+    sim::record_mission(sim::make_named_scenario("corridor", map, geojson, robot, 1), log_path);
+    log = io::read_mission_log(log_path);
+  }
+  ~CorridorRun() { fs::remove_all(dir); }
+
+  // Starts the node; every image kept (as replay takes them) however loaded the machine running
+  // the tests is.
+  void start_node(const std::string& options) const {
+    const std::string cmd = std::string(LAMPNAV_BINARY) + " node --robot '" + robot_path +
+                            "' --map '" + test::source_path("maps/office_floor.geojson") +
+                            "' --domain " + domain + " " + options +
+                            " --joint-states-topic /joint_states --wheel-radius 0.1"
+                            " --images-waiting 100000 --idle-exit 3 --quiet --stats '" +
+                            dir + "/stats.json' > '" + dir + "/node.out' 2>&1 &";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+  }
+  // Plays the log, then waits for the node's counts.
+  nlohmann::json play(const std::string& options) const {
+    int status = -1;
+    const std::string played = test::run_command(
+        std::string(LAMPNAV_LOG_PLAYER) + " '" + log_path + "' --domain " + domain +
+            " --wheel-radius 0.1 " + options + " --poses '" + dir + "/poses.txt' 2>&1",
+        &status);
+    EXPECT_EQ(status, 0) << played;
+    std::cout << "player: " << played;
+    if (!test::wait_for([&] { return fs::exists(dir + "/stats.json"); }, 30)) {
+      ADD_FAILURE() << "no counts from the node: " << test::slurp(dir + "/node.out");
+      return {};
+    }
+    // The file is written whole before the node ends.
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    std::cout << "node: " << test::slurp(dir + "/node.out");
+    return nlohmann::json::parse(test::slurp(dir + "/stats.json"));
+  }
+  // The poses the player heard, by stamp (the first for each).
+  std::map<std::int64_t, Pose2> poses() const {
+    std::map<std::int64_t, Pose2> out;
+    std::ifstream in(dir + "/poses.txt");
+    std::string line;
+    while (std::getline(in, line)) {
+      std::istringstream s(line);
+      std::int64_t t;
+      double x, y, yaw;
+      s >> t >> x >> y >> yaw;
+      out.emplace(t, Pose2(x, y, yaw));
+    }
+    return out;
+  }
+};
+
+TEST(Node, PublishesThePosesReplayComputesFromTheSameLog) {
+  const CorridorRun run("node_test");
+  const evaluation::ReplayResult replayed = evaluation::replay(run.log, run.map, run.robot);
+  run.start_node("");
+  const nlohmann::json stats = run.play("--rate 2");
+  ASSERT_FALSE(stats.is_null());
 
   // Nothing lost: every message the player sent arrived and was used.
-  EXPECT_EQ(stats["odometry"]["received"], log.wheels.size());
-  EXPECT_EQ(stats["odometry"]["used"], log.wheels.size());
-  EXPECT_EQ(stats["ceiling"]["used"], log.ceiling_images.size());
-  EXPECT_EQ(stats["omni"]["used"], log.omni_images.size());
+  EXPECT_EQ(stats["odometry"]["received"], run.log.wheels.size());
+  EXPECT_EQ(stats["odometry"]["used"], run.log.wheels.size());
+  EXPECT_EQ(stats["ceiling"]["used"], run.log.ceiling_images.size());
+  EXPECT_EQ(stats["omni"]["used"], run.log.omni_images.size());
 
   // The first pose published for each wheel reading is replay's estimate there.
-  std::map<std::int64_t, Pose2> node;
-  std::ifstream in(dir + "/poses.txt");
-  std::string line;
-  while (std::getline(in, line)) {
-    std::istringstream s(line);
-    std::int64_t t;
-    double x, y, yaw;
-    s >> t >> x >> y >> yaw;
-    node.emplace(t, Pose2(x, y, yaw));
-  }
-  fs::remove_all(dir);
+  const std::map<std::int64_t, Pose2> node = run.poses();
   std::size_t certain = 0, compared = 0;
   double worst = 0;
   for (const auto& e : replayed.estimates) {
@@ -101,59 +125,24 @@ TEST(Node, PublishesThePosesReplayComputesFromTheSameLog) {
 // Pose Estimate" on /initialpose (sent by the player after the first wheel reading, where the
 // robot starts) tells it, and it tracks the drive from there on the ceiling camera alone.
 TEST(Node, TracksFromAnOperatorsPoseEstimate) {
-  const std::string geojson = test::slurp(test::source_path("maps/office_floor.geojson"));
-  const graph::TopologicalMap map = graph::parse_map(geojson, "office_floor.geojson").map;
-  const std::string robot_path = test::source_path("maps/robots/pioneer.json");
-  const RobotDescription robot = read_robot_description(robot_path);
-  const std::string dir = test::temp_path("node_estimate_test");
-  fs::create_directories(dir);
-  const std::string log_path = dir + "/corridor.mcap";
-  sim::record_mission(sim::make_named_scenario("corridor", map, geojson, robot, 1), log_path);
-  const io::MissionLog log = io::read_mission_log(log_path);
-  const io::TruthTrack truth(log.truth);
-  const Pose2 start = truth.at(log.wheels.front().value.stamp);
-
-  const std::string domain = std::to_string(test::test_domain());
-  const std::string node_cmd = std::string(LAMPNAV_BINARY) + " node --robot '" + robot_path +
-                               "' --map '" + test::source_path("maps/office_floor.geojson") +
-                               "' --domain " + domain +
-                               " --no-omni --joint-states-topic /joint_states --wheel-radius 0.1"
-                               " --images-waiting 100000 --idle-exit 3 --quiet --stats '" +
-                               dir + "/stats.json' > '" + dir + "/node.out' 2>&1 &";
-  ASSERT_EQ(std::system(node_cmd.c_str()), 0);
+  const CorridorRun run("node_estimate_test");
+  const io::TruthTrack truth(run.log.truth);
+  const Pose2 start = truth.at(run.log.wheels.front().value.stamp);
+  run.start_node("--no-omni");
   char at[96];
   std::snprintf(at, sizeof at, "%.9f,%.9f,%.9f", start.x(), start.y(), start.yaw());
-  int status = -1;
-  const std::string played =
-      test::run_command(std::string(LAMPNAV_LOG_PLAYER) + " '" + log_path + "' --domain " + domain +
-                            " --rate 3 --wheel-radius 0.1 --pose-estimate " + at + " --poses '" +
-                            dir + "/poses.txt' 2>&1",
-                        &status);
-  ASSERT_EQ(status, 0) << played;
-  std::cout << "player: " << played;
-  ASSERT_TRUE(test::wait_for([&] { return fs::exists(dir + "/stats.json"); }, 30))
-      << test::slurp(dir + "/node.out");
-  std::this_thread::sleep_for(std::chrono::milliseconds(500));
-  const nlohmann::json stats = nlohmann::json::parse(test::slurp(dir + "/stats.json"));
+  const nlohmann::json stats = run.play(std::string("--rate 3 --pose-estimate ") + at);
+  ASSERT_FALSE(stats.is_null());
   EXPECT_EQ(stats["pose_estimates"]["used"], 1u);
   EXPECT_EQ(stats["omni_frames"], 0u);
-
-  std::ifstream in(dir + "/poses.txt");
-  std::string line;
-  std::size_t poses = 0;
+  const std::map<std::int64_t, Pose2> poses = run.poses();
   double worst = 0;
-  while (std::getline(in, line)) {
-    std::istringstream s(line);
-    std::int64_t t;
-    double x, y, yaw;
-    s >> t >> x >> y >> yaw;
-    ++poses;
-    worst = std::max(
-        worst, (truth.at(stamp_from_nanoseconds(t)).translation() - Eigen::Vector2d(x, y)).norm());
-  }
-  fs::remove_all(dir);
-  std::cout << poses << " poses published, at most " << worst * 100 << " cm from the truth\n";
-  EXPECT_GT(poses, 3000u);  // one a wheel reading from the estimate on
+  for (const auto& [t, p] : poses)
+    worst = std::max(worst,
+                     (truth.at(stamp_from_nanoseconds(t)).translation() - p.translation()).norm());
+  std::cout << poses.size() << " poses published, at most " << worst * 100
+            << " cm from the truth\n";
+  EXPECT_GT(poses.size(), 3000u);  // one a wheel reading from the estimate on
   EXPECT_LT(worst, 0.1);
 }
 
