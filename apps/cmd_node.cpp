@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include "commands.hpp"
@@ -50,11 +51,19 @@ struct Publisher : navigation::RuntimeObserver {
     robot->publish(e);
     mission_news();
   }
-  void after_frame(CameraRole camera) {
+  // Publishes the localizer's estimate as it stands, once it has a pose or places; returns it
+  // (nullopt: nothing to publish yet).
+  std::optional<fusion::LocalizerEstimate> publish_current() {
     const fusion::Localizer& l = runtime->localizer();
-    const fusion::LocalizerEstimate e = l.estimate();
-    if (!l.initialized() && e.hypotheses.empty()) return;
+    fusion::LocalizerEstimate e = l.estimate();
+    if (!l.initialized() && e.hypotheses.empty()) return std::nullopt;
     robot->publish(e);
+    return e;
+  }
+  void after_frame(CameraRole camera) {
+    const std::optional<fusion::LocalizerEstimate> published = publish_current();
+    if (!published) return;
+    const fusion::LocalizerEstimate& e = *published;
     const auto now = ros::Clock::now();
     const bool omni = camera == CameraRole::omni;
     const double arrival =
@@ -91,9 +100,7 @@ struct Publisher : navigation::RuntimeObserver {
                                  ? std::string("pose estimate taken: the robot at ") + at
                                  : std::string("pose estimate at ") + at + " refused: " + why;
     robot->publish_event(text);
-    // The pose goes out now, as a fix (relocalized) for the cameras to confirm.
-    const fusion::LocalizerEstimate e = runtime->localizer().estimate();
-    if (runtime->localizer().initialized() || !e.hypotheses.empty()) robot->publish(e);
+    publish_current();  // the pose goes out now, as a fix (relocalized) for the cameras to confirm
     if (!quiet) diagnostic("note", text);
   }
   // The mission's end, once.

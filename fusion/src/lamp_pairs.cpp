@@ -88,10 +88,9 @@ namespace {
 // Unsigned, from clamped floors: a map far from its origin wraps the key, never overflows it.
 std::int64_t cell_of(const Pose2& p) {
   const double cell_m = 0.25, cell_rad = 3 * kDeg;
-  auto index = [](double v) { return static_cast<std::uint64_t>(detail::clamped_floor(v)); };
-  return static_cast<std::int64_t>((index(p.x() / cell_m) * 1000003u + index(p.y() / cell_m)) *
-                                       1009u +
-                                   index((p.yaw() + M_PI) / cell_rad));
+  return static_cast<std::int64_t>(
+      detail::cell_key(detail::clamped_floor(p.x() / cell_m), detail::clamped_floor(p.y() / cell_m),
+                       detail::clamped_floor((p.yaw() + M_PI) / cell_rad)));
 }
 std::string too_few_seeds(std::size_t n, const LampPairOptions& q) {
   return std::to_string(n) + " lamp(s) within " + std::to_string(int(q.pair_max_theta_deg)) +

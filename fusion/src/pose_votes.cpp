@@ -112,12 +112,8 @@ void PoseVotes::count() {
     for (std::size_t i = 0; i < n; ++i) {
       const Halves& p = halves[i];
       const std::int64_t a = half_down(p.a + sa);
-      // Unsigned (clamped_floor).
       const std::uint64_t u =
-          ((std::uint64_t(half_down(p.x + sx)) * 1000003u + std::uint64_t(half_down(p.y + sy))) *
-               1009u +
-           std::uint64_t(a >= kTurn ? a - kTurn : a)) *
-              kGrids +
+          cell_key(half_down(p.x + sx), half_down(p.y + sy), a >= kTurn ? a - kTurn : a) * kGrids +
           std::uint64_t(g);
       const std::int64_t key = static_cast<std::int64_t>(u);
       std::size_t h = mix(key) & mask;

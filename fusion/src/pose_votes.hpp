@@ -25,6 +25,12 @@ inline std::int64_t clamped_floor(double v) {
   return v == v ? std::int64_t(std::floor(std::clamp(v, -1e15, 1e15))) : 0;
 }
 
+// The key of cell (x, y, a): x and y the cell's indices along the axes, a along yaw (unsigned:
+// wraps, never overflows).
+inline std::uint64_t cell_key(std::int64_t x, std::int64_t y, std::int64_t a) {
+  return (std::uint64_t(x) * 1000003u + std::uint64_t(y)) * 1009u + std::uint64_t(a);
+}
+
 class PoseVotes {
  public:
   PoseVotes();

@@ -97,8 +97,8 @@ RunOutcome Runtime::run(Robot& robot, const std::optional<Pose2>& start,
         obs.on_pose_estimate(*p, "");
       } else {
         obs.on_pose_estimate(*p,
-                             "the filter refused it (its time is before the filter's "
-                             "history, or its covariance is not usable)");
+                             "the filter refused it (a time outside the filter's history, or a "
+                             "pose or covariance it cannot use)");
       }
       continue;
     }
