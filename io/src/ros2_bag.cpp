@@ -234,8 +234,13 @@ std::optional<InRoot> in_root(const std::map<std::string, const FrameTransform*>
 }  // namespace
 
 std::optional<MountFromTf> mount_from_tf(const MissionLog& log, const std::string& frame) {
+  return mount_from_tf(log.transforms, frame);
+}
+
+std::optional<MountFromTf> mount_from_tf(const std::vector<FrameTransform>& transforms,
+                                         const std::string& frame) {
   std::map<std::string, const FrameTransform*> parent_of;  // by child: the latest
-  for (const auto& t : log.transforms) parent_of[t.child] = &t;
+  for (const auto& t : transforms) parent_of[t.child] = &t;
   const auto camera = in_root(parent_of, frame);
   if (!camera) return std::nullopt;
   for (const char* base : {"base_footprint", "base_link"}) {

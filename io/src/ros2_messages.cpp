@@ -253,6 +253,12 @@ std::vector<FrameTransform> tf_transforms(const std::string& data) {
   return out;
 }
 
+MessageHeader message_header(const std::string& data) {
+  CdrReader r(data);
+  const Header h = header(r);
+  return {h.stamp, h.frame_id};
+}
+
 std::string string_data(const std::string& data) {
   CdrReader r(data);
   return r.string("data");
@@ -298,6 +304,18 @@ std::string tf_message(const std::vector<Transform>& transforms) {
   for (const auto& t : transforms) {
     w.header(ns(t.stamp), t.parent).string(t.child);
     pose(w, t.pose);  // translation and rotation: the same five doubles as a pose
+  }
+  return w.take();
+}
+
+std::string tf_message(const std::vector<FrameTransform>& transforms) {
+  CdrWriter w;
+  w.u32(static_cast<std::uint32_t>(transforms.size()));
+  for (const auto& t : transforms) {
+    w.header(ns(t.stamp), t.parent).string(t.child);
+    w.f64(t.translation.x()).f64(t.translation.y()).f64(t.translation.z());
+    const Eigen::Quaterniond& q = t.rotation;
+    w.f64(q.x()).f64(q.y()).f64(q.z()).f64(q.w());
   }
   return w.take();
 }

@@ -107,7 +107,7 @@ void image(const std::uint8_t* data, std::size_t size) {
 void ros2_cdr(const std::uint8_t* data, std::size_t size) {
   if (size == 0) return;
   const std::string in = text(data + 1, size - 1);
-  switch (data[0] % 9) {
+  switch (data[0] % 10) {
     case 0:
       contract([&] { return io::ros2::compressed_image(in); },
                [](const io::ImageFrame& f) {
@@ -155,7 +155,19 @@ void ros2_cdr(const std::uint8_t* data, std::size_t size) {
                });
       break;
     case 6:
-      contract([&] { return io::ros2::tf_transforms(in); }, [](const auto&) {});
+      contract([&] { return io::ros2::tf_transforms(in); },
+               [](const std::vector<io::FrameTransform>& t) {
+                 const auto again = io::ros2::tf_transforms(io::ros2::tf_message(t));
+                 if (again.size() != t.size()) broken("transforms written and read again differ");
+                 for (std::size_t k = 0; k < t.size(); ++k)
+                   if (again[k].child != t[k].child || again[k].parent != t[k].parent ||
+                       again[k].translation != t[k].translation ||
+                       (again[k].rotation.coeffs() - t[k].rotation.coeffs()).norm() > 1e-12)
+                     broken("transforms written and read again differ");
+               });
+      break;
+    case 9:
+      contract([&] { return io::ros2::message_header(in); }, [](const auto&) {});
       break;
     case 8:
       contract([&] { return io::ros2::pose_estimate(in); },

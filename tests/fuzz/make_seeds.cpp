@@ -174,6 +174,8 @@ int main(int argc, char** argv) {
   cdr(8, "pose_estimate",
       io::ros2::pose_with_covariance_stamped(t, "map", Pose2(3.5, -1.25, 0.4),
                                              Eigen::Vector3d(0.25, 0.25, 0.0685).asDiagonal()));
+  cdr(9, "message_header",
+      io::ros2::compressed_image_message(t, "ceiling_optical", "png", std::string(8, '\x89')));
 
   // Images.
   put("image", "tiny.png", io::encode_png(tiny(12, 10)));

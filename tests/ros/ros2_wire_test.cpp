@@ -103,6 +103,21 @@ TEST(RosWire, EveryMessageIsByteForByteWhatRos2ToolingWrites) {
           {"transform",
            {{"translation", point(q.x(), q.y())}, {"rotation", quaternion(q.yaw())}}}}}}},
       io::ros2::tf_message({{t, "map", "odom", q}}));
+  // A camera's mount on /tf_static, in three dimensions (the log player sends them so).
+  io::FrameTransform mount;
+  mount.stamp = t;
+  mount.parent = "base_footprint";
+  mount.child = "ceiling_optical";
+  mount.translation = {0.125, -0.05, 0.375};
+  mount.rotation = Eigen::Quaterniond(0.5, -0.5, 0.5, -0.5);
+  add("tf2_msgs/msg/TFMessage",
+      {{"transforms",
+        {{{"header", header(t, "base_footprint")},
+          {"child_frame_id", "ceiling_optical"},
+          {"transform",
+           {{"translation", {{"x", 0.125}, {"y", -0.05}, {"z", 0.375}}},
+            {"rotation", {{"x", -0.5}, {"y", 0.5}, {"z", -0.5}, {"w", 0.5}}}}}}}}},
+      io::ros2::tf_message(std::vector{mount}));
   add("geometry_msgs/msg/Twist",
       {{"linear", {{"x", 0.35}, {"y", 0.0}, {"z", 0.0}}},
        {"angular", {{"x", 0.0}, {"y", 0.0}, {"z", -0.4}}}},

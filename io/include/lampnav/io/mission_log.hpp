@@ -285,6 +285,9 @@ struct MountFromTf {
   std::string base;                               // the base frame used
 };
 std::optional<MountFromTf> mount_from_tf(const MissionLog& log, const std::string& frame);
+// The same from transforms in the order they came (a live node's /tf_static).
+std::optional<MountFromTf> mount_from_tf(const std::vector<FrameTransform>& transforms,
+                                         const std::string& frame);
 
 // The truth of a log at any instant, interpolated between the samples around it. A kidnap is a
 // jump between two samples (more than 0.5 m): no interpolation across it.

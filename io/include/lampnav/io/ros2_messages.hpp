@@ -50,6 +50,13 @@ CameraInfo camera_info(const std::string& cdr);
 std::string string_data(const std::string& cdr);
 // tf2_msgs/msg/TFMessage (from /tf or /tf_static).
 std::vector<FrameTransform> tf_transforms(const std::string& cdr);
+// The std_msgs/msg/Header a message begins with (images, camera info, odometry, ...): read
+// without the rest, for a node that must know a camera's frame before it decodes the image.
+struct MessageHeader {
+  Stamp stamp;
+  std::string frame_id;
+};
+MessageHeader message_header(const std::string& cdr);
 // geometry_msgs/msg/PoseWithCovarianceStamped, as RViz's and Foxglove's "2D Pose Estimate"
 // publish on /initialpose: the planar pose and its covariance over (x, y, yaw). Refused when not
 // finite, when the orientation is not a unit quaternion, or when the (x, y, yaw) covariance is
@@ -79,6 +86,8 @@ std::string pose_with_covariance_stamped(Stamp stamp, const std::string& frame, 
 std::string pose_array(Stamp stamp, const std::string& frame, const std::vector<Pose2>& poses);
 // tf2_msgs/msg/TFMessage.
 std::string tf_message(const std::vector<Transform>& transforms);
+// The same with transforms in three dimensions (a camera's mount on /tf_static).
+std::string tf_message(const std::vector<FrameTransform>& transforms);
 // geometry_msgs/msg/Twist: forward speed (m/s) and turn rate (rad/s).
 std::string twist(double forward, double turn);
 // std_msgs/msg/String.
