@@ -95,13 +95,17 @@ class CdrBytes : public dds::TopicDataType {
   bool getKey(void*, eprosima::fastrtps::rtps::InstanceHandle_t*, bool) override { return false; }
 };
 
-void apply(Qos q, dds::ReliabilityQosPolicy& reliability, dds::DurabilityQosPolicy& durability,
-           dds::HistoryQosPolicy& history) {
+void apply(Qos q, bool reader, dds::ReliabilityQosPolicy& reliability,
+           dds::DurabilityQosPolicy& durability, dds::HistoryQosPolicy& history) {
   reliability.kind =
       q == Qos::sensor_data ? dds::BEST_EFFORT_RELIABILITY_QOS : dds::RELIABLE_RELIABILITY_QOS;
-  durability.kind = dds::VOLATILE_DURABILITY_QOS;
+  durability.kind =
+      q == Qos::tf_static ? dds::TRANSIENT_LOCAL_DURABILITY_QOS : dds::VOLATILE_DURABILITY_QOS;
   history.kind = dds::KEEP_LAST_HISTORY_QOS;
-  history.depth = q == Qos::sensor_data ? 5 : q == Qos::state ? 10 : 100;
+  history.depth = q == Qos::sensor_data            ? 5
+                  : q == Qos::state                ? 10
+                  : q == Qos::tf_static && !reader ? 1
+                                                   : 100;
 }
 
 class Listener : public dds::DataReaderListener {
@@ -216,7 +220,7 @@ void Participant::subscribe(const std::string& ros_topic, const std::string& ros
   std::lock_guard<std::mutex> lock(impl_->mutex);
   dds::Topic* t = impl_->topic(ros_topic, ros_type);
   dds::DataReaderQos qos = impl_->subscriber->get_default_datareader_qos();
-  apply(q, qos.reliability(), qos.durability(), qos.history());
+  apply(q, true, qos.reliability(), qos.durability(), qos.history());
   qos.endpoint().history_memory_policy =
       eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   auto listener = std::make_unique<Listener>(std::move(on_sample));
@@ -230,7 +234,7 @@ Writer& Participant::writer(const std::string& ros_topic, const std::string& ros
   std::lock_guard<std::mutex> lock(impl_->mutex);
   dds::Topic* t = impl_->topic(ros_topic, ros_type);
   dds::DataWriterQos qos = impl_->publisher->get_default_datawriter_qos();
-  apply(q, qos.reliability(), qos.durability(), qos.history());
+  apply(q, false, qos.reliability(), qos.durability(), qos.history());
   qos.endpoint().history_memory_policy =
       eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
   qos.publish_mode().kind = dds::SYNCHRONOUS_PUBLISH_MODE;  // as rmw_fastrtps by default

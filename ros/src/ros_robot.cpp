@@ -86,6 +86,9 @@ struct Inbox {
   std::unique_ptr<TaskThread> ceiling_decoder, omni_decoder;
   // Each camera's images in the queue (not yet taken by next()).
   std::size_t ceiling_waiting = 0, omni_waiting = 0;
+  std::string ceiling_frame, omni_frame;  // the first image's header.frame_id
+  std::vector<io::FrameTransform> static_transforms;
+  std::vector<std::string> problems;  // from /tf_static, not yet reported
 
   std::size_t& waiting(InputKind kind) {
     return kind == InputKind::ceiling ? ceiling_waiting : omni_waiting;
@@ -197,6 +200,7 @@ RosRobot::RosRobot(Participant& p, const RosRobotOptions& options)
     if (!t.pose_estimate.empty())
       subscribe(p, t.pose_estimate, "geometry_msgs/msg/PoseWithCovarianceStamped", Qos::state,
                 InputKind::pose_estimate);
+    if (!t.tf_static.empty()) subscribe_static_transforms(p);
   } catch (...) {
     close();  // the subscriptions made so far stay with the participant
     throw;
@@ -235,6 +239,14 @@ void RosRobot::subscribe(Participant& p, const std::string& topic, const std::st
                   detail::Pending pending{kind, std::move(s), {}, {}};
                   const bool image = pending.is_image();
                   if (image) {
+                    // The camera's frame, from the first image whose header reads (a header
+                    // that does not is refused with the image, by its decoder).
+                    std::string& frame =
+                        kind == InputKind::ceiling ? inbox->ceiling_frame : inbox->omni_frame;
+                    if (frame.empty()) try {
+                        frame = io::ros2::message_header(pending.sample.cdr).frame_id;
+                      } catch (const io::CdrError&) {
+                      }
                     auto dropped = std::make_shared<std::atomic<bool>>(false);
                     pending.dropped = dropped;
                     pending.image =
@@ -257,6 +269,53 @@ void RosRobot::subscribe(Participant& p, const std::string& topic, const std::st
                 }
                 inbox->ready.notify_one();
               });
+}
+
+void RosRobot::subscribe_static_transforms(Participant& p) {
+  // A few small messages, at start: decoded as they come, on the DDS thread.
+  p.subscribe(o_.topics.tf_static, "tf2_msgs/msg/TFMessage", Qos::tf_static,
+              [inbox = inbox_, topic = o_.topics.tf_static](Sample&& s) {
+                std::vector<io::FrameTransform> transforms;
+                std::string problem;
+                try {
+                  transforms = io::ros2::tf_transforms(s.cdr);
+                } catch (const io::CdrError& e) {
+                  problem = e.what();
+                }
+                std::lock_guard<std::mutex> lock(inbox->mutex);
+                if (inbox->closed) return;
+                InputCounts& c = inbox->counts.static_transforms;
+                ++c.received;
+                if (!problem.empty()) {
+                  ++c.refused;
+                  inbox->problems.push_back(topic + ", message " + std::to_string(s.sequence) +
+                                            ": " + problem);
+                  return;
+                }
+                ++c.used;
+                for (auto& t : transforms) {
+                  t.is_static = true;
+                  inbox->static_transforms.push_back(std::move(t));
+                }
+              });
+}
+
+std::string RosRobot::camera_frame(CameraRole camera) const {
+  std::lock_guard<std::mutex> lock(inbox_->mutex);
+  return camera == CameraRole::ceiling ? inbox_->ceiling_frame : inbox_->omni_frame;
+}
+
+std::vector<io::FrameTransform> RosRobot::static_transforms() {
+  std::vector<std::string> problems;
+  std::vector<io::FrameTransform> out;
+  {
+    std::lock_guard<std::mutex> lock(inbox_->mutex);
+    problems.swap(inbox_->problems);
+    out = inbox_->static_transforms;
+  }
+  if (on_problem)
+    for (const auto& p : problems) on_problem(p);
+  return out;
 }
 
 const std::string& RosRobot::topic_of(InputKind kind) const {

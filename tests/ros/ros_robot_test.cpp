@@ -375,5 +375,56 @@ TEST(RosRobot, TakesAnOperatorsPoseEstimate) {
   EXPECT_THAT(problems[1], HasSubstr("pose.covariance"));
 }
 
+// The cameras' mounts as a ROS robot publishes them: robot_state_publisher's /tf_static, sent
+// before the node was there (transient local), reaches it; a camera's frame is known from its
+// first image before anything is taken; a damaged TFMessage is refused naming the topic and the
+// message, and the transforms taken before it stay.
+TEST(RosRobot, TakesStaticTransformsAndTheCamerasFrame) {
+  const int domain = test::test_domain();
+  Participant drivers(domain);
+  Writer& tf_static = drivers.writer("/tf_static", "tf2_msgs/msg/TFMessage", Qos::tf_static);
+  io::FrameTransform base, camera;
+  base.parent = "base_footprint";
+  base.child = "base_link";
+  base.translation = {0, 0, 0.1};
+  camera.parent = "base_link";
+  camera.child = "ceiling_optical";
+  camera.translation = {0.2, 0, 0.3};
+  camera.rotation = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ());
+  ASSERT_TRUE(tf_static.write(io::ros2::tf_message(std::vector{base, camera})));
+
+  Participant node_side(domain);  // joins after the transforms were sent
+  const RosRobotOptions o = ceiling_camera_only("/ceiling_camera/image_raw/compressed");
+  RosRobot robot(node_side, o);
+  std::vector<std::string> problems;
+  robot.on_problem = [&](const std::string& p) { problems.push_back(p); };
+  ASSERT_TRUE(test::wait_for([&] { return robot.counts().static_transforms.used == 1; }))
+      << "the transforms sent before the node came did not reach it";
+  EXPECT_EQ(robot.camera_frame(CameraRole::ceiling), "");
+
+  Writer& image =
+      drivers.writer(o.topics.ceiling_image, "sensor_msgs/msg/CompressedImage", Qos::sensor_data);
+  ASSERT_TRUE(test::wait_for([&] { return image.matched(); }));
+  ASSERT_TRUE(image.write(io::ros2::compressed_image_message(at(1), "ceiling_optical", "png",
+                                                             "not decoded before it is taken")));
+  ASSERT_TRUE(test::wait_for([&] { return !robot.camera_frame(CameraRole::ceiling).empty(); }));
+  EXPECT_EQ(robot.camera_frame(CameraRole::ceiling), "ceiling_optical");
+
+  const std::string whole = io::ros2::tf_message(std::vector{camera});
+  ASSERT_TRUE(tf_static.write(whole.substr(0, whole.size() - 9)));
+  ASSERT_TRUE(test::wait_for([&] { return robot.counts().static_transforms.refused == 1; }));
+  const std::vector<io::FrameTransform> taken = robot.static_transforms();
+  ASSERT_EQ(taken.size(), 2u);
+  EXPECT_TRUE(taken[0].is_static);
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_THAT(problems[0], HasSubstr("/tf_static, message 2"));
+
+  const auto mount = io::mount_from_tf(taken, robot.camera_frame(CameraRole::ceiling));
+  ASSERT_TRUE(mount.has_value());
+  EXPECT_EQ(mount->base, "base_footprint");
+  EXPECT_NEAR((mount->xyz - Eigen::Vector3d(0.2, 0, 0.4)).norm(), 0, 1e-12);
+  EXPECT_NEAR((mount->rpy - Eigen::Vector3d(0, 0, M_PI / 2)).norm(), 0, 1e-12);
+}
+
 }  // namespace
 }  // namespace lampnav::ros

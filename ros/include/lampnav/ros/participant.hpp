@@ -19,6 +19,9 @@ enum class Qos {
   sensor_data,  // best effort, volatile, keep last 5 (cameras, odometry)
   state,        // reliable, volatile, keep last 10 (ROS 2's default)
   tf,           // reliable, volatile, keep last 100 (tf2_ros::TransformBroadcaster)
+  // Reliable, transient local (a late joiner is sent what was published before it came): keep
+  // last 1 writing, 100 reading (tf2_ros's static broadcaster and listener on /tf_static).
+  tf_static,
 };
 
 // "/lampnav/pose" -> "rt/lampnav/pose". Throws InputError for a name ROS 2 would refuse.

@@ -41,6 +41,9 @@ struct NodeTopics {
   // geometry_msgs/msg/PoseWithCovarianceStamped in the map frame: an operator's "2D Pose
   // Estimate" (RViz, Foxglove), taken as a fix. Empty: not subscribed.
   std::string pose_estimate = "/initialpose";
+  // tf2_msgs/msg/TFMessage, transient local: the cameras' mounts (robot_state_publisher's, from
+  // the robot's URDF). Empty: not subscribed.
+  std::string tf_static = "/tf_static";
   std::string cmd_vel = "/cmd_vel";  // geometry_msgs/msg/Twist
   // Outputs under this namespace: pose, mode, hypotheses, events (and /tf).
   std::string ns = "/lampnav";
@@ -79,7 +82,7 @@ struct InputCounts {
 };
 
 struct NodeCounts {
-  InputCounts ceiling, omni, odometry, commands, pose_estimates;
+  InputCounts ceiling, omni, odometry, commands, pose_estimates, static_transforms;
   std::uint64_t poses_published = 0;
 };
 
@@ -106,6 +109,12 @@ class RosRobot : public Robot {
   Clock::time_point last_arrival() const { return last_arrival_; }
   Clock::time_point last_ready() const { return last_ready_; }
   NodeCounts counts() const;
+  // The frame_id of the first image of `camera` that came (before it is decoded); empty while
+  // none has.
+  std::string camera_frame(CameraRole camera) const;
+  // The transforms that came on /tf_static so far, in order. Messages that did not decode are
+  // counted, and reported through on_problem by this call.
+  std::vector<io::FrameTransform> static_transforms();
   // Called for each message refused, with the reason (topic, message number, field).
   std::function<void(const std::string&)> on_problem;
 
@@ -113,6 +122,7 @@ class RosRobot : public Robot {
   std::optional<RobotInput> decode(detail::Pending& p);
   void subscribe(Participant& p, const std::string& topic, const std::string& type, Qos qos,
                  detail::InputKind kind);
+  void subscribe_static_transforms(Participant& p);
   const std::string& topic_of(detail::InputKind kind) const;
   // Closes the inbox: its callbacks drop what comes from then on; the decoding threads finish.
   void close();
