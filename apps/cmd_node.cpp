@@ -31,6 +31,7 @@ extern "C" void on_signal(int) { g_stop = true; }
 struct NodeArgs {
   std::string robot, map, initial_pose, stats;
   int domain = -1;
+  double tf_wait_s = 1;
   bool no_ceiling = false, no_omni = false, quiet = false;
   ros::RosRobotOptions robot_options;
 };
@@ -45,6 +46,10 @@ struct Publisher : navigation::RuntimeObserver {
   // Frames after which no pose went out, only the hypotheses (the robot not yet found): arrival
   // to hypotheses out. Their first omni images search the whole map.
   std::vector<double> searching_us[2];
+  // Frames that came before the loop started (while the node waited for the cameras' mounts):
+  // their time in the queue is the wait's, not the node's, and they are counted apart.
+  ros::Clock::time_point started;
+  std::size_t before_start[2] = {0, 0};
   std::string last_mission;
 
   void on_estimate(const fusion::LocalizerEstimate& e) override {
@@ -66,6 +71,10 @@ struct Publisher : navigation::RuntimeObserver {
     const fusion::LocalizerEstimate& e = *published;
     const auto now = ros::Clock::now();
     const bool omni = camera == CameraRole::omni;
+    if (robot->last_arrival() < started) {
+      ++before_start[omni];
+      return;
+    }
     const double arrival =
         std::chrono::duration<double, std::micro>(now - robot->last_arrival()).count();
     if (!e.known()) {
@@ -128,6 +137,61 @@ nlohmann::json counts_json(const ros::InputCounts& c) {
       {"received", c.received}, {"used", c.used}, {"refused", c.refused}, {"dropped", c.dropped}};
 }
 
+// The cameras' mounts from /tf_static (robot_state_publisher's, from the robot's URDF), as a
+// bag's transforms give them to replay: the node waits until every camera in use has sent an
+// image and /tf_static joins the base to each image's frame, or until `wait_s` after the first
+// message of any kind came. A camera not joined keeps robot.json's mount (a note says so).
+std::vector<std::string> mounts_from_static_tf(ros::RosRobot& ros_robot, const NodeArgs& a,
+                                               RobotDescription& robot) {
+  const ros::NodeTopics& t = a.robot_options.topics;
+  std::vector<std::pair<CameraRole, std::string>> used;  // role, camera name
+  if (!t.ceiling_image.empty()) used.emplace_back(CameraRole::ceiling, "ceiling_camera");
+  if (!t.omni_image.empty()) used.emplace_back(CameraRole::omni, "omni_camera");
+  std::optional<ros::Clock::time_point> first_message;
+  std::vector<io::FrameTransform> transforms;
+  for (;;) {
+    if (g_stop) return {};
+    transforms = ros_robot.static_transforms();
+    bool joined = true;
+    for (const auto& [role, name] : used) {
+      const std::string frame = ros_robot.camera_frame(role);
+      joined &= !frame.empty() && io::mount_from_tf(transforms, frame).has_value();
+    }
+    if (joined) break;
+    const ros::NodeCounts c = ros_robot.counts();
+    if (!first_message && c.ceiling.received + c.omni.received + c.odometry.received +
+                                  c.commands.received + c.pose_estimates.received >
+                              0)
+      first_message = ros::Clock::now();
+    if (first_message &&
+        ros::Clock::now() - *first_message > std::chrono::duration<double>(a.tf_wait_s))
+      break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  char waited[32];
+  std::snprintf(waited, sizeof waited, "%g s", a.tf_wait_s);
+  auto note = [&](const std::string& text) {
+    if (!a.quiet) diagnostic("note", text);
+  };
+  if (transforms.empty()) {
+    note("nothing came on " + t.tf_static + " within " + waited +
+         " of the first message: the cameras' mounts from robot.json");
+    return {};
+  }
+  for (const auto& [role, name] : used)
+    if (ros_robot.camera_frame(role).empty())
+      note(name + " sent no image within " + waited +
+           " of the first message: its mount from robot.json");
+  return mounts_from_tf(
+      transforms,
+      [&](const CameraDescription& c) {
+        for (const auto& [role, name] : used)
+          if (name == c.name) return ros_robot.camera_frame(role);
+        return std::string();
+      },
+      "node", t.tf_static, robot, a.quiet);
+}
+
 int run_node(NodeArgs& a) {
   // Images of up to a megabyte come and go at 30 Hz. By default glibc maps each such block from
   // the kernel and gives it back when freed, so every frame's pixels are faulted in again page by
@@ -135,7 +199,7 @@ int run_node(NodeArgs& a) {
   // them: blocks below 32 MB come from the heap, and the heap is not trimmed below 256 MB free.
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TRIM_THRESHOLD, 256 << 20);
-  const RobotDescription robot = read_robot_description(a.robot);
+  RobotDescription robot = read_robot_description(a.robot);
   const graph::LoadedMap loaded = graph::parse_map(json::read_file(a.map), a.map);
   std::optional<Pose2> start;
   if (!a.initial_pose.empty()) start = parse_pose_option(a.initial_pose, "--initial-pose");
@@ -152,22 +216,24 @@ int run_node(NodeArgs& a) {
                      "estimate topic to be told on");
   ro.validate();
   const int domain = a.domain >= 0 ? a.domain : ros::domain_from_environment();
-
-  navigation::RuntimeOptions opts;
-  opts.max_duration_s = 1e9;  // a live node runs until stopped
-  navigation::Runtime runtime(loaded.map, robot, opts);
   ros::Participant participant(domain);
   ros::RosRobot ros_robot(participant, ro);
   ros_robot.on_problem = [](const std::string& p) { diagnostic("error", p); };
 
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  std::atomic<bool> done{false};
+  std::atomic<bool> done{false}, looping{false};
   std::thread watcher([&] {
     ros::NodeCounts reported;
+    bool counting = false;  // images dropped while the node waited for the mounts are not news
     for (int tick = 1; !done; ++tick) {
       if (g_stop) ros_robot.stop();
-      if (!a.quiet && tick % 100 == 0) {  // every 5 s: images dropped since the last report
+      if (!counting && looping) {
+        counting = true;
+        reported = ros_robot.counts();
+        tick = 1;
+      }
+      if (counting && !a.quiet && tick % 100 == 0) {  // every 5 s: images dropped since then
         const ros::NodeCounts c = ros_robot.counts();
         const std::uint64_t ceiling = c.ceiling.dropped - reported.ceiling.dropped,
                             omni = c.omni.dropped - reported.omni.dropped;
@@ -193,11 +259,26 @@ int run_node(NodeArgs& a) {
   if (!a.quiet && !start && ro.topics.omni_image.empty())
     diagnostic("note", "no starting pose and no omni camera: waiting for a pose estimate on " +
                            ro.topics.pose_estimate);
+  std::vector<std::string> tf_mounts;
+  std::optional<navigation::Runtime> made;
+  try {
+    if (!ro.topics.tf_static.empty()) tf_mounts = mounts_from_static_tf(ros_robot, a, robot);
+    navigation::RuntimeOptions opts;
+    opts.max_duration_s = 1e9;  // a live node runs until stopped
+    made.emplace(loaded.map, robot, opts);
+  } catch (...) {
+    done = true;
+    watcher.join();
+    throw;
+  }
+  navigation::Runtime& runtime = *made;
   Publisher pub;
   pub.robot = &ros_robot;
   pub.runtime = &runtime;
   pub.quiet = a.quiet;
   navigation::RunOutcome out;
+  pub.started = ros::Clock::now();
+  looping = true;
   try {
     out = runtime.run(ros_robot, start, {}, &pub, true);
   } catch (...) {
@@ -239,6 +320,9 @@ int run_node(NodeArgs& a) {
         {"odometry", counts_json(c.odometry)},
         {"commands", counts_json(c.commands)},
         {"pose_estimates", counts_json(c.pose_estimates)},
+        {"static_transforms", counts_json(c.static_transforms)},
+        {"mounts_from_tf", tf_mounts},
+        {"images_before_start", {{"ceiling", pub.before_start[0]}, {"omni", pub.before_start[1]}}},
         {"wheel_readings", out.wheel_readings},
         {"ceiling_frames", out.ceiling_frames},
         {"omni_frames", out.omni_frames},
@@ -282,6 +366,15 @@ void add_node_command(CLI::App& app, Job& run) {
   c->add_option("--pose-estimate-topic", t.pose_estimate,
                 "geometry_msgs/msg/PoseWithCovarianceStamped in the map frame: an operator's pose "
                 "estimate, taken as a fix (\"\": none)")
+      ->capture_default_str();
+  c->add_option("--tf-static-topic", t.tf_static,
+                "tf2_msgs/msg/TFMessage: the cameras' mounts where they join base_footprint (or "
+                "base_link) to the images' frames; robot.json's elsewhere (\"\": robot.json's)")
+      ->capture_default_str();
+  c->add_option("--tf-wait", a->tf_wait_s,
+                "at start, wait this long after the first message for the mounts on the "
+                "tf_static topic (s)")
+      ->check(CLI::Range(0.0, 60.0))
       ->capture_default_str();
   c->add_option("--command-topic", t.command, "std_msgs/msg/String route commands")
       ->capture_default_str();

@@ -6,6 +6,7 @@
 #include <functional>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 #include "lampnav/core/pose2.hpp"
 #include "lampnav/core/robot_description.hpp"
@@ -17,6 +18,7 @@ class App;
 namespace lampnav::io {
 struct MissionLog;
 struct BagTopics;
+struct FrameTransform;
 }  // namespace lampnav::io
 
 namespace lampnav::apps {
@@ -66,6 +68,16 @@ io::MissionLog read_log_for_cameras(const std::string& log_path, const std::stri
 io::MissionLog read_log_for_robot(const std::string& log_path, const std::string& robot_path,
                                   const io::BagTopics& topics, RobotDescription& robot,
                                   std::string* robot_text = nullptr);
+
+// The cameras' mounts from ROS transforms (a bag's /tf_static and /tf, the node's /tf_static)
+// where they join base_footprint (or base_link) to the frame a camera's images are stamped with
+// (`frame_of`: "" when the camera sent none); robot.json's mounts stay where they do not. Each
+// camera's outcome is said on stderr as a note naming `source` and the transforms (`what`)
+// unless `quiet`. Returns the cameras whose mount came from the transforms.
+std::vector<std::string> mounts_from_tf(
+    const std::vector<io::FrameTransform>& transforms,
+    const std::function<std::string(const CameraDescription&)>& frame_of, const std::string& source,
+    const std::string& what, RobotDescription& robot, bool quiet = false);
 
 // X,Y,YAW (m, m, rad) from a command-line option; InputError naming `flag` otherwise.
 Pose2 parse_pose_option(const std::string& text, const std::string& flag);

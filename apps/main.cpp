@@ -95,41 +95,42 @@ namespace {
 
 std::string triple(const Eigen::Vector3d& v) {
   std::ostringstream s;
-  s << std::setprecision(4) << "[" << v.x() << ", " << v.y() << ", " << v.z() << "]";
+  // + 0.0: a negative zero (from atan2) printed as 0.
+  s << std::setprecision(4) << "[" << v.x() + 0.0 << ", " << v.y() + 0.0 << ", " << v.z() + 0.0
+    << "]";
   return s.str();
 }
 
-// A bag's transforms (/tf_static, /tf) give the cameras' mounts where they join the base to the
-// frame its images are stamped with; robot.json's mounts stay where they do not.
-void mounts_from_tf(const io::MissionLog& log, const std::string& log_path, RobotDescription& robot,
-                    std::string* robot_text) {
-  if (log.transforms.empty()) return;
-  bool changed = false;
+}  // namespace
+
+std::vector<std::string> mounts_from_tf(
+    const std::vector<io::FrameTransform>& transforms,
+    const std::function<std::string(const CameraDescription&)>& frame_of, const std::string& source,
+    const std::string& what, RobotDescription& robot, bool quiet) {
+  std::vector<std::string> taken;
+  auto note = [&](const std::string& text) {
+    if (!quiet) diagnostic("note", source + ": " + text);
+  };
   for (auto& c : robot.cameras) {
-    const auto& frames = c.name == "ceiling_camera" ? log.ceiling_images : log.omni_images;
-    if ((c.name != "ceiling_camera" && c.name != "omni_camera") || frames.empty()) continue;
-    const std::string& frame = frames.front().value.frame_id;
-    const auto m = io::mount_from_tf(log, frame);
+    if (c.name != "ceiling_camera" && c.name != "omni_camera") continue;
+    const std::string frame = frame_of(c);
+    if (frame.empty()) continue;
+    const auto m = io::mount_from_tf(transforms, frame);
     if (!m) {
-      diagnostic("note", log_path + ": no transform joins base_footprint or base_link to " + frame +
-                             ": " + c.name + "'s mount from robot.json");
+      note("no transform of " + what + " joins base_footprint or base_link to " + frame + ": " +
+           c.name + "'s mount from robot.json");
       continue;
     }
-    diagnostic(
-        "note",
-        log_path + ": " + c.name + " mount from the bag's transforms (" + m->base + " -> " + frame +
-            "): xyz " + triple(m->xyz) + ", rpy " + triple(m->rpy) + " (robot.json: xyz " +
-            triple(c.mount.xyz) + ", rpy " + triple(c.mount.rpy) + ")" +
-            (m->base == "base_link" ? "; lampnav's base is on the floor: base_link must be too"
-                                    : ""));
+    note(c.name + " mount from " + what + " (" + m->base + " -> " + frame + "): xyz " +
+         triple(m->xyz) + ", rpy " + triple(m->rpy) + " (robot.json: xyz " + triple(c.mount.xyz) +
+         ", rpy " + triple(c.mount.rpy) + ")" +
+         (m->base == "base_link" ? "; lampnav's base is on the floor: base_link must be too" : ""));
     c.mount.xyz = m->xyz;
     c.mount.rpy = m->rpy;
-    changed = true;
+    taken.push_back(c.name);
   }
-  if (changed && robot_text) *robot_text = to_robot_json(robot);
+  return taken;
 }
-
-}  // namespace
 
 io::MissionLog read_log_for_cameras(const std::string& log_path, const std::string& robot_path,
                                     const io::BagTopics& topics, RobotDescription& robot,
@@ -138,7 +139,15 @@ io::MissionLog read_log_for_cameras(const std::string& log_path, const std::stri
   robot = robot_for_log(log, log_path, robot_path, robot_text);
   if (log.ros2_bag) {
     for (const auto& n : log.notes) diagnostic("note", log_path + ": " + n);
-    mounts_from_tf(log, log_path, robot, robot_text);
+    const auto first_frame = [&](const CameraDescription& c) {
+      const auto& frames = c.name == "ceiling_camera" ? log.ceiling_images : log.omni_images;
+      return frames.empty() ? std::string() : frames.front().value.frame_id;
+    };
+    if (!log.transforms.empty() &&
+        !mounts_from_tf(log.transforms, first_frame, log_path, "the bag's transforms", robot)
+             .empty() &&
+        robot_text)
+      *robot_text = to_robot_json(robot);
   }
   return log;
 }

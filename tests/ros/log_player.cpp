@@ -7,6 +7,7 @@
 //   lampnav_log_player LOG.mcap --domain D [--rate R] [--wheel-radius M] [--poses OUT]
 //                      [--wait-s S] [--loops N] [--jpeg QUALITY | --raw]
 //                      [--pose-estimate X,Y,YAW]   (sent on /initialpose after the first wheels)
+//                      [--tf-static]   (the log's camera mounts on /tf_static, transient local)
 // Prints one line of counts; exit 0, 1 when no node answered, 2 for bad arguments.
 
 #include <atomic>
@@ -23,6 +24,7 @@
 #include "cdr_writer.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/core/image.hpp"
+#include "lampnav/core/robot_description.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/io/ros2_messages.hpp"
 #include "lampnav/ros/participant.hpp"
@@ -60,6 +62,25 @@ int main(int argc, char** argv) {
       p.writer("/omni_camera/image_raw" + suffix, image_type, ros::Qos::sensor_data);
   ros::Writer& estimate =
       p.writer("/initialpose", "geometry_msgs/msg/PoseWithCovarianceStamped", ros::Qos::state);
+  if (o.tf_static) {
+    // Written now, before the node is matched: DDS keeps it for readers that come later.
+    if (!log.robot_json) {
+      std::cerr << "lampnav_log_player: --tf-static: the log has no robot.json\n";
+      return 2;
+    }
+    const RobotDescription robot = parse_robot_description(*log.robot_json, o.log);
+    std::vector<io::FrameTransform> mounts;
+    for (const auto& c : robot.cameras) {
+      io::FrameTransform t;
+      t.parent = "base_footprint";
+      t.child = c.name;  // the frame the player stamps the camera's images with
+      t.translation = c.mount.xyz;
+      t.rotation = Eigen::Quaterniond(c.mount.rotation());
+      mounts.push_back(t);
+    }
+    p.writer("/tf_static", "tf2_msgs/msg/TFMessage", ros::Qos::tf_static)
+        .write(io::ros2::tf_message(mounts));
+  }
   // Raw frames are decoded before playing, as a camera driver hands them over.
   std::vector<Image8> raw_ceiling, raw_omni;
   if (o.raw) {

@@ -46,10 +46,11 @@ struct CorridorRun {
 
   // Starts the node; every image kept (as replay takes them) however loaded the machine running
   // the tests is.
-  void start_node(const std::string& options) const {
-    const std::string cmd = std::string(LAMPNAV_BINARY) + " node --robot '" + robot_path +
-                            "' --map '" + test::source_path("maps/office_floor.geojson") +
-                            "' --domain " + domain + " " + options +
+  void start_node(const std::string& options, const std::string& robot_file = "") const {
+    const std::string cmd = std::string(LAMPNAV_BINARY) + " node --robot '" +
+                            (robot_file.empty() ? robot_path : robot_file) + "' --map '" +
+                            test::source_path("maps/office_floor.geojson") + "' --domain " +
+                            domain + " " + options +
                             " --joint-states-topic /joint_states --wheel-radius 0.1"
                             " --images-waiting 100000 --idle-exit 3 --quiet --stats '" +
                             dir + "/stats.json' > '" + dir + "/node.out' 2>&1 &";
@@ -89,6 +90,28 @@ struct CorridorRun {
   }
 };
 
+// The node's poses against replay's certain estimates: how many the node published (the first
+// for each wheel reading) and how far apart they are at most (m).
+struct Agreement {
+  std::size_t certain = 0, compared = 0;
+  double worst = 0;
+};
+Agreement agreement(const std::map<std::int64_t, Pose2>& node,
+                    const evaluation::ReplayResult& replayed) {
+  Agreement a;
+  for (const auto& e : replayed.estimates) {
+    if (!fusion::is_certain(e.mode)) continue;
+    ++a.certain;
+    const auto it = node.find(to_nanoseconds(e.stamp));
+    if (it == node.end()) continue;
+    ++a.compared;
+    a.worst = std::max(a.worst, (it->second.translation() - e.pose.translation()).norm());
+  }
+  std::cout << a.compared << " of replay's " << a.certain << " certain poses published by the "
+            << "node, at most " << a.worst * 1000 << " mm apart\n";
+  return a;
+}
+
 TEST(Node, PublishesThePosesReplayComputesFromTheSameLog) {
   const CorridorRun run("node_test");
   const evaluation::ReplayResult replayed = evaluation::replay(run.log, run.map, run.robot);
@@ -101,24 +124,50 @@ TEST(Node, PublishesThePosesReplayComputesFromTheSameLog) {
   EXPECT_EQ(stats["odometry"]["used"], run.log.wheels.size());
   EXPECT_EQ(stats["ceiling"]["used"], run.log.ceiling_images.size());
   EXPECT_EQ(stats["omni"]["used"], run.log.omni_images.size());
+  // Nothing on /tf_static: robot.json's mounts.
+  EXPECT_EQ(stats["static_transforms"]["received"], 0u);
+  EXPECT_TRUE(stats["mounts_from_tf"].empty());
 
   // The first pose published for each wheel reading is replay's estimate there.
-  const std::map<std::int64_t, Pose2> node = run.poses();
-  std::size_t certain = 0, compared = 0;
-  double worst = 0;
-  for (const auto& e : replayed.estimates) {
-    if (!fusion::is_certain(e.mode)) continue;
-    ++certain;
-    const auto it = node.find(to_nanoseconds(e.stamp));
-    if (it == node.end()) continue;
-    ++compared;
-    worst = std::max(worst, (it->second.translation() - e.pose.translation()).norm());
+  const Agreement a = agreement(run.poses(), replayed);
+  EXPECT_GT(a.certain, 3000u);
+  EXPECT_EQ(a.compared, a.certain);
+  EXPECT_LE(a.worst, 1e-3);
+}
+
+// A robot.json whose camera mounts are wrong (the ceiling camera 8 cm off and turned 5 degrees,
+// the omni camera 6 cm off) on a robot whose /tf_static has them right (the player sends the
+// log's, before the node is matched, as robot_state_publisher does): the node takes the mounts
+// from /tf_static and publishes the poses replay computes with the right robot.json.
+TEST(Node, TakesTheCameraMountsFromTfStatic) {
+  const CorridorRun run("node_tf_test");
+  RobotDescription wrong = run.robot;
+  for (auto& c : wrong.cameras) {
+    if (c.name == "ceiling_camera") {
+      c.mount.xyz.x() += 0.08;
+      c.mount.rpy.z() += 5 * M_PI / 180;
+    }
+    if (c.name == "omni_camera") c.mount.xyz.y() += 0.06;
   }
-  std::cout << compared << " of replay's " << certain << " certain poses published by the node, "
-            << "at most " << worst * 1000 << " mm apart\n";
-  EXPECT_GT(certain, 3000u);
-  EXPECT_EQ(compared, certain);
-  EXPECT_LE(worst, 1e-3);
+  const std::string wrong_path = run.dir + "/wrong_mounts.json";
+  std::ofstream(wrong_path) << to_robot_json(wrong);
+  const evaluation::ReplayResult replayed = evaluation::replay(run.log, run.map, run.robot);
+  // The wrong mounts matter: replayed with them, the poses are centimetres off.
+  const evaluation::ReplayResult misplaced = evaluation::replay(run.log, run.map, wrong);
+  std::map<std::int64_t, Pose2> misplaced_poses;
+  for (const auto& e : misplaced.estimates)
+    if (fusion::is_certain(e.mode)) misplaced_poses.emplace(to_nanoseconds(e.stamp), e.pose);
+  EXPECT_GT(agreement(misplaced_poses, replayed).worst, 0.02);
+
+  run.start_node("", wrong_path);
+  const nlohmann::json stats = run.play("--rate 2 --tf-static");
+  ASSERT_FALSE(stats.is_null());
+  EXPECT_EQ(stats["static_transforms"]["used"], 1u);
+  EXPECT_EQ(stats["mounts_from_tf"], nlohmann::json({"ceiling_camera", "omni_camera"}));
+  const Agreement a = agreement(run.poses(), replayed);
+  EXPECT_GT(a.certain, 3000u);
+  EXPECT_EQ(a.compared, a.certain);
+  EXPECT_LE(a.worst, 1e-3);
 }
 
 // Without a start and without the omni camera the node cannot find the robot; an operator's "2D

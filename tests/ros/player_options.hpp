@@ -17,6 +17,9 @@ struct PlayerOptions {
   int domain = 0, loops = 1;
   int jpeg_quality = 0;  // > 0: images sent as JPEG of this quality (decoded and encoded first)
   bool raw = false;      // images sent as sensor_msgs/msg/Image (mono8), decoded first
+  // The cameras' mounts of the log's robot.json sent on /tf_static (base_footprint -> each
+  // camera's frame), once, before any node is there (transient local, as robot_state_publisher).
+  bool tf_static = false;
   double rate = 1, wheel_radius = 0.1, wait_s = 20, linger_s = 3;
   // An operator's "2D Pose Estimate" (x, y, yaw) sent on /initialpose after the first wheels.
   std::optional<Pose2> pose_estimate;
@@ -51,6 +54,8 @@ inline PlayerOptions parse_player_options(int argc, char** argv) {
       o.jpeg_quality = static_cast<int>(number(k));
     else if (a == "--raw")
       o.raw = true;
+    else if (a == "--tf-static")
+      o.tf_static = true;
     else if (a == "--pose-estimate" && k + 1 < argc) {
       double x = 0, y = 0, yaw = 0;
       char tail = 0;
