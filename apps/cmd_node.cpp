@@ -214,6 +214,8 @@ int run_node(NodeArgs& a) {
     throw InputError({"", "option", "--initial-pose"},
                      "no starting pose, no omni camera to find the robot with, and no pose "
                      "estimate topic to be told on");
+  // The images that come while the node waits for the cameras' mounts are all kept.
+  ro.hold_images = !ro.topics.tf_static.empty();
   ro.validate();
   const int domain = a.domain >= 0 ? a.domain : ros::domain_from_environment();
   ros::Participant participant(domain);
@@ -272,6 +274,7 @@ int run_node(NodeArgs& a) {
     throw;
   }
   navigation::Runtime& runtime = *made;
+  ros_robot.release_images();
   Publisher pub;
   pub.robot = &ros_robot;
   pub.runtime = &runtime;

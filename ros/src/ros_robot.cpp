@@ -73,6 +73,8 @@ struct Pending {
   std::future<DecodedImage> image;
   // An image's: set when it is dropped, so that its decoding is skipped if not yet begun.
   std::shared_ptr<std::atomic<bool>> dropped;
+  // An image counted among its camera's waiting ones (not one held before the node started).
+  bool counted = false;
 
   bool is_image() const { return kind == InputKind::ceiling || kind == InputKind::omni; }
 };
@@ -86,6 +88,7 @@ struct Inbox {
   std::unique_ptr<TaskThread> ceiling_decoder, omni_decoder;
   // Each camera's images in the queue (not yet taken by next()).
   std::size_t ceiling_waiting = 0, omni_waiting = 0;
+  bool holding = false;                   // images kept, uncounted, until release_images()
   std::string ceiling_frame, omni_frame;  // the first image's header.frame_id
   std::vector<io::FrameTransform> static_transforms;
   std::vector<std::string> problems;  // from /tf_static, not yet reported
@@ -93,14 +96,15 @@ struct Inbox {
   std::size_t& waiting(InputKind kind) {
     return kind == InputKind::ceiling ? ceiling_waiting : omni_waiting;
   }
-  // Drops the oldest image in the queue (of `kind`, or of either camera): counted, and not
-  // decoded if its decoding has not begun. The caller holds the mutex.
+  // Drops the oldest image in the queue (the oldest counted one of `kind`, or the oldest of
+  // either camera): counted, and not decoded if its decoding has not begun. The caller holds
+  // the mutex.
   void drop_oldest_image(std::optional<InputKind> kind) {
     for (auto it = queue.begin(); it != queue.end(); ++it)
-      if (it->is_image() && (!kind || it->kind == *kind)) {
+      if (it->is_image() && (!kind || (it->kind == *kind && it->counted))) {
         *it->dropped = true;
         ++counts_of(it->kind).dropped;
-        --waiting(it->kind);
+        if (it->counted) --waiting(it->kind);
         queue.erase(it);
         return;
       }
@@ -183,6 +187,7 @@ RosRobot::RosRobot(Participant& p, const RosRobotOptions& options)
   hypotheses_ = &p.writer(t.ns + "/hypotheses", "geometry_msgs/msg/PoseArray", Qos::state);
   events_ = &p.writer(t.ns + "/events", "std_msgs/msg/String", Qos::state);
   inbox_ = std::make_shared<detail::Inbox>();
+  inbox_->holding = o_.hold_images;
   if (!t.ceiling_image.empty()) inbox_->ceiling_decoder = decoding_thread(o_.ceiling_size);
   if (!t.omni_image.empty()) inbox_->omni_decoder = decoding_thread(o_.omni_size);
   try {
@@ -258,11 +263,15 @@ void RosRobot::subscribe(Participant& p, const std::string& topic, const std::st
                             });
                   }
                   ++inbox->counts_of(kind).received;
-                  inbox->queue.push_back(std::move(pending));
                   // A camera whose images come faster than they are processed has its oldest
                   // waiting image dropped, so that what is processed stays recent and the
                   // queue's memory bounded (ROS 2's sensor-data QoS keeps the last five too).
-                  if (image && ++inbox->waiting(kind) > max_images) inbox->drop_oldest_image(kind);
+                  // Images held before the node started are not counted: they go first.
+                  pending.counted = image && !inbox->holding;
+                  const bool counted = pending.counted;
+                  inbox->queue.push_back(std::move(pending));
+                  if (counted && ++inbox->waiting(kind) > max_images)
+                    inbox->drop_oldest_image(kind);
                   // Behind by more than the queue holds: an old image goes first (odometry and
                   // commands are small and each one counts).
                   if (inbox->queue.size() > max_queue) inbox->drop_oldest_image(std::nullopt);
@@ -298,6 +307,11 @@ void RosRobot::subscribe_static_transforms(Participant& p) {
                   inbox->static_transforms.push_back(std::move(t));
                 }
               });
+}
+
+void RosRobot::release_images() {
+  std::lock_guard<std::mutex> lock(inbox_->mutex);
+  inbox_->holding = false;
 }
 
 std::string RosRobot::camera_frame(CameraRole camera) const {
@@ -365,7 +379,7 @@ std::optional<RobotInput> RosRobot::next() {
       }
       p = std::move(inbox_->queue.front());
       inbox_->queue.pop_front();
-      if (p.is_image()) --inbox_->waiting(p.kind);
+      if (p.counted) --inbox_->waiting(p.kind);
     }
     any_input_ = true;
     last_input_ = Clock::now();

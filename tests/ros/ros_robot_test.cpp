@@ -289,6 +289,40 @@ TEST(RosRobot, KeepsTheNewestImagesWhenItFallsBehind) {
   EXPECT_EQ(c.odometry.dropped, 0u);
 }
 
+// A node that waits for its cameras' mounts before it starts holds every image that comes until
+// it releases them: those go first, all of them, and the bound applies to the images after.
+TEST(RosRobot, HoldsEveryImageUntilReleased) {
+  const int domain = test::test_domain();
+  Participant node_side(domain), drivers(domain);
+  RosRobotOptions o = ceiling_camera_only("/ceiling_camera/image_raw");
+  o.hold_images = true;
+  RosRobot robot(node_side, o);
+  Writer& camera =
+      drivers.writer(o.topics.ceiling_image, "sensor_msgs/msg/Image", Qos::sensor_data);
+  ASSERT_TRUE(test::wait_for([&] { return camera.matched(); }));
+  auto send = [&](int first, int count) {
+    for (int k = first; k < first + count; ++k) {
+      ASSERT_TRUE(camera.write(test::mono8_image_cdr(to_nanoseconds(at(0.1 * k)), "ceiling_camera",
+                                                     64, 48, 64, std::string(64 * 48, char(k)))));
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    ASSERT_TRUE(test::wait_for(
+        [&] { return robot.counts().ceiling.received == std::size_t(first + count); }));
+  };
+  send(0, 20);  // held
+  EXPECT_EQ(robot.counts().ceiling.dropped, 0u);
+  robot.release_images();
+  send(20, 10);  // the newest 5 of these kept
+  EXPECT_EQ(robot.counts().ceiling.dropped, 5u);
+
+  const Taken taken = take_inputs(robot, [&](const Taken& t) { return t.frames.size() >= 25; });
+  ASSERT_EQ(taken.frames.size(), 25u);
+  for (int k = 0; k < 25; ++k) {
+    const int n = k < 20 ? k : k + 5;
+    EXPECT_EQ(taken.frames[k].image.pixels[0], std::uint8_t(n)) << "frame " << k;
+  }
+}
+
 // Compressed images, decoded on the camera's own thread after it decoded frames of the camera's
 // size at start: each comes out as its bytes decode, in arrival order; a damaged one is reported
 // with its topic and number and the next one taken.

@@ -73,6 +73,10 @@ struct RosRobotOptions {
   // decoding began). A node slower than its cameras then processes recent images, a bounded
   // time after they came, instead of falling further behind (docs/ros2.md, "Falling behind").
   std::size_t max_images_waiting = 5;
+  // Every image is kept from the start until release_images() (a node that waits for its
+  // cameras' mounts before it starts): those images are processed first, and the bound above
+  // applies to the images that come after.
+  bool hold_images = false;
   double idle_exit_s = 0;  // > 0: next() ends after this long with no input, once one came
   void validate() const;   // throws InputError naming the option
 };
@@ -109,6 +113,8 @@ class RosRobot : public Robot {
   Clock::time_point last_arrival() const { return last_arrival_; }
   Clock::time_point last_ready() const { return last_ready_; }
   NodeCounts counts() const;
+  // Ends hold_images: from now on each camera's waiting images are bounded.
+  void release_images();
   // The frame_id of the first image of `camera` that came (before it is decoded); empty while
   // none has.
   std::string camera_frame(CameraRole camera) const;
