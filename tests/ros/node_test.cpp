@@ -208,6 +208,12 @@ TEST(Node, RefusesBadOptionsWithStatus2) {
   EXPECT_THAT(out, ::testing::HasSubstr("--wheel-radius"));
   out = test::run_command(base + "--domain 300 2>&1", &status);
   EXPECT_EQ(status, 2) << out;
+  out = test::run_command(base + "--tf-wait 100 2>&1", &status);
+  EXPECT_EQ(status, 2) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("--tf-wait"));
+  out = test::run_command(base + "--tf-static-topic tf_static 2>&1", &status);
+  EXPECT_EQ(status, 2) << out;
+  EXPECT_THAT(out, ::testing::HasSubstr("tf_static: not a ROS 2 topic name"));
   out = test::run_command("ROS_DOMAIN_ID=abc " + base + "2>&1", &status);
   EXPECT_EQ(status, 2) << out;
   EXPECT_THAT(out, ::testing::HasSubstr("ROS_DOMAIN_ID"));
