@@ -141,12 +141,18 @@ nlohmann::json counts_json(const ros::InputCounts& c) {
 // bag's transforms give them to replay: the node waits until every camera in use has sent an
 // image and /tf_static joins the base to each image's frame, or until `wait_s` after the first
 // message of any kind came. A camera not joined keeps robot.json's mount (a note says so).
+// The cameras the node reads: role and robot.json name.
+std::vector<std::pair<CameraRole, std::string>> cameras_in_use(const ros::NodeTopics& t) {
+  std::vector<std::pair<CameraRole, std::string>> used;
+  if (!t.ceiling_image.empty()) used.emplace_back(CameraRole::ceiling, "ceiling_camera");
+  if (!t.omni_image.empty()) used.emplace_back(CameraRole::omni, "omni_camera");
+  return used;
+}
+
 std::vector<std::string> mounts_from_static_tf(ros::RosRobot& ros_robot, const NodeArgs& a,
                                                RobotDescription& robot) {
   const ros::NodeTopics& t = a.robot_options.topics;
-  std::vector<std::pair<CameraRole, std::string>> used;  // role, camera name
-  if (!t.ceiling_image.empty()) used.emplace_back(CameraRole::ceiling, "ceiling_camera");
-  if (!t.omni_image.empty()) used.emplace_back(CameraRole::omni, "omni_camera");
+  const auto used = cameras_in_use(t);
   std::optional<ros::Clock::time_point> first_message;
   std::vector<io::FrameTransform> transforms;
   for (;;) {
@@ -192,6 +198,27 @@ std::vector<std::string> mounts_from_static_tf(ros::RosRobot& ros_robot, const N
       "node", t.tf_static, robot, a.quiet);
 }
 
+// Once running, the mounts are not changed: a camera whose mount on /tf_static came or changed
+// after the start (robot_state_publisher started late, a URDF edited) is told once, with what to
+// do. Damaged /tf_static messages are reported here too.
+void check_late_mounts(ros::RosRobot& ros_robot, const NodeArgs& a, const RobotDescription& robot,
+                       std::vector<std::string>& warned) {
+  const std::vector<io::FrameTransform> transforms = ros_robot.static_transforms();
+  for (const auto& [role, name] : cameras_in_use(a.robot_options.topics)) {
+    const CameraDescription* c = robot.find_camera(name);
+    const std::string frame = ros_robot.camera_frame(role);
+    if (!c || frame.empty() || std::count(warned.begin(), warned.end(), name)) continue;
+    const auto m = io::mount_from_tf(transforms, frame);
+    if (!m || ((m->xyz - c->mount.xyz).norm() < 1e-3 && (m->rpy - c->mount.rpy).norm() < 1e-3))
+      continue;
+    warned.push_back(name);
+    diagnostic("warning", name + "'s mount on " + a.robot_options.topics.tf_static +
+                              " came or changed after the node started (" + m->base + " -> " +
+                              frame + "): the node goes on with the mount it started with; " +
+                              "restart it to take the new one");
+  }
+}
+
 int run_node(NodeArgs& a) {
   // Images of up to a megabyte come and go at 30 Hz. By default glibc maps each such block from
   // the kernel and gives it back when freed, so every frame's pixels are faulted in again page by
@@ -228,6 +255,7 @@ int run_node(NodeArgs& a) {
   std::thread watcher([&] {
     ros::NodeCounts reported;
     bool counting = false;  // images dropped while the node waited for the mounts are not news
+    std::vector<std::string> warned;
     for (int tick = 1; !done; ++tick) {
       if (g_stop) ros_robot.stop();
       if (!counting && looping) {
@@ -235,6 +263,9 @@ int run_node(NodeArgs& a) {
         reported = ros_robot.counts();
         tick = 1;
       }
+      // Every second; `robot` is the node's own from the start on.
+      if (counting && tick % 20 == 0 && !ro.topics.tf_static.empty())
+        check_late_mounts(ros_robot, a, robot, warned);
       if (counting && !a.quiet && tick % 100 == 0) {  // every 5 s: images dropped since then
         const ros::NodeCounts c = ros_robot.counts();
         const std::uint64_t ceiling = c.ceiling.dropped - reported.ceiling.dropped,
