@@ -137,10 +137,6 @@ nlohmann::json counts_json(const ros::InputCounts& c) {
       {"received", c.received}, {"used", c.used}, {"refused", c.refused}, {"dropped", c.dropped}};
 }
 
-// The cameras' mounts from /tf_static (robot_state_publisher's, from the robot's URDF), as a
-// bag's transforms give them to replay: the node waits until every camera in use has sent an
-// image and /tf_static joins the base to each image's frame, or until `wait_s` after the first
-// message of any kind came. A camera not joined keeps robot.json's mount (a note says so).
 // The cameras the node reads: role and robot.json name.
 std::vector<std::pair<CameraRole, std::string>> cameras_in_use(const ros::NodeTopics& t) {
   std::vector<std::pair<CameraRole, std::string>> used;
@@ -149,6 +145,10 @@ std::vector<std::pair<CameraRole, std::string>> cameras_in_use(const ros::NodeTo
   return used;
 }
 
+// The cameras' mounts from /tf_static (robot_state_publisher's, from the robot's URDF), as a
+// bag's transforms give them to replay: the node waits until every camera in use has sent an
+// image and /tf_static joins the base to each image's frame, or until --tf-wait seconds after the
+// first message of any kind came. A camera not joined keeps robot.json's mount (a note says so).
 std::vector<std::string> mounts_from_static_tf(ros::RosRobot& ros_robot, const NodeArgs& a,
                                                RobotDescription& robot) {
   const ros::NodeTopics& t = a.robot_options.topics;
@@ -209,7 +209,9 @@ void check_late_mounts(ros::RosRobot& ros_robot, const NodeArgs& a, const RobotD
     const std::string frame = ros_robot.camera_frame(role);
     if (!c || frame.empty() || std::count(warned.begin(), warned.end(), name)) continue;
     const auto m = io::mount_from_tf(transforms, frame);
-    if (!m || ((m->xyz - c->mount.xyz).norm() < 1e-3 && (m->rpy - c->mount.rpy).norm() < 1e-3))
+    // Compared as rotations: roll, pitch and yaw wrap.
+    if (!m || ((m->xyz - c->mount.xyz).norm() < 1e-3 &&
+               (Mount{m->xyz, m->rpy}.rotation() - c->mount.rotation()).norm() < 1e-3))
       continue;
     warned.push_back(name);
     diagnostic("warning", name + "'s mount on " + a.robot_options.topics.tf_static +

@@ -1,5 +1,6 @@
 #include "lampnav/ros/ros_robot.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <condition_variable>
@@ -297,14 +298,23 @@ void RosRobot::subscribe_static_transforms(Participant& p) {
                 ++c.received;
                 if (!problem.empty()) {
                   ++c.refused;
-                  inbox->problems.push_back(topic + ", message " + std::to_string(s.sequence) +
-                                            ": " + problem);
+                  if (inbox->problems.size() < 100)  // until they are reported
+                    inbox->problems.push_back(topic + ", message " + std::to_string(s.sequence) +
+                                              ": " + problem);
                   return;
                 }
                 ++c.used;
+                // The latest of each child frame (as mount_from_tf takes them), in place: a
+                // publisher that sends its transforms again and again takes no more memory.
                 for (auto& t : transforms) {
                   t.is_static = true;
-                  inbox->static_transforms.push_back(std::move(t));
+                  auto& kept = inbox->static_transforms;
+                  const auto same = std::find_if(kept.begin(), kept.end(),
+                                                 [&](const auto& k) { return k.child == t.child; });
+                  if (same != kept.end())
+                    *same = std::move(t);
+                  else
+                    kept.push_back(std::move(t));
                 }
               });
 }

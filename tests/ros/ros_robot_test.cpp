@@ -447,11 +447,15 @@ TEST(RosRobot, TakesStaticTransformsAndTheCamerasFrame) {
   const std::string whole = io::ros2::tf_message(std::vector{camera});
   ASSERT_TRUE(tf_static.write(whole.substr(0, whole.size() - 9)));
   ASSERT_TRUE(test::wait_for([&] { return robot.counts().static_transforms.refused == 1; }));
+  // Sent again (a publisher that repeats them): the latest of each frame is kept, no more.
+  ASSERT_TRUE(tf_static.write(whole));
+  ASSERT_TRUE(test::wait_for([&] { return robot.counts().static_transforms.used == 2; }));
   const std::vector<io::FrameTransform> taken = robot.static_transforms();
   ASSERT_EQ(taken.size(), 2u);
   EXPECT_TRUE(taken[0].is_static);
   ASSERT_EQ(problems.size(), 1u);
   EXPECT_THAT(problems[0], HasSubstr("/tf_static, message 2"));
+  EXPECT_EQ(taken[1].child, "ceiling_optical");
 
   const auto mount = io::mount_from_tf(taken, robot.camera_frame(CameraRole::ceiling));
   ASSERT_TRUE(mount.has_value());

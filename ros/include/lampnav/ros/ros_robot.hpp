@@ -118,8 +118,9 @@ class RosRobot : public Robot {
   // The frame_id of the first image of `camera` that came (before it is decoded); empty while
   // none has.
   std::string camera_frame(CameraRole camera) const;
-  // The transforms that came on /tf_static so far, in order. Messages that did not decode are
-  // counted, and reported through on_problem by this call.
+  // The transforms that came on /tf_static so far, the latest of each child frame, in the order
+  // the frames first came. Messages that did not decode are counted, and reported through
+  // on_problem by this call.
   std::vector<io::FrameTransform> static_transforms();
   // Called for each message refused, with the reason (topic, message number, field).
   std::function<void(const std::string&)> on_problem;
