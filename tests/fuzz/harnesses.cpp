@@ -144,7 +144,16 @@ void ros2_cdr(const std::uint8_t* data, std::size_t size) {
                });
       break;
     case 4:
-      contract([&] { return io::ros2::camera_info(in); }, [](const io::CameraInfo&) {});
+      contract([&] { return io::ros2::camera_info(in); },
+               [](const io::CameraInfo& info) {
+                 // The camera it describes: read, or refused as bad input.
+                 try {
+                   if (const auto c = io::camera_from_info(info, "fuzz"))
+                     if (c->width != info.width || c->height != info.height)
+                       broken("a CameraInfo's camera is not its size");
+                 } catch (const InputError&) {
+                 }
+               });
       break;
     case 5:
       contract([&] { return io::ros2::string_data(in); },

@@ -13,6 +13,7 @@
 
 #include "lampnav/core/error.hpp"
 #include "lampnav/io/calibration.hpp"
+#include "lampnav/io/mission_log.hpp"
 #include "lampnav/vision/camera_models.hpp"
 #include "lampnav_test.hpp"
 
@@ -117,6 +118,61 @@ distortion_coefficients: {rows: 1, cols: 4, data: [0.034, -0.0041, 0.00062, -0.0
   EXPECT_LT(worst_fisheye, 0.01);
   std::filesystem::remove(webcam);
   std::filesystem::remove(fish);
+}
+
+// A driver's CameraInfo (a bag's, a live camera's) is read as its YAML is; one published
+// uncalibrated (K all zero) describes nothing; a model lampnav does not read is refused naming
+// the topic, the frame and the field. projection_difference_px tells a description from itself
+// (below 1e-6 px: the pinhole's undistortion is iterative), from the same camera 0.5 % longer in
+// focal length (more than 1 px at the edges), and from another size (infinity).
+TEST(Calibration, CameraInfoMessagesAndHowFarApartTwoDescriptionsAre) {
+  CameraInfo info;
+  info.frame_id = "ceiling_optical";
+  info.width = 640;
+  info.height = 480;
+  info.distortion_model = "plumb_bob";
+  info.d = {-0.112, 0.071, 0.0012, -0.0007, -0.013};
+  info.k = {612.3, 0, 318.2, 0, 610.8, 241.7, 0, 0, 1};
+  const auto from_message = camera_from_info(info, "/ceiling/camera_info");
+  ASSERT_TRUE(from_message);
+  EXPECT_EQ(from_message->model, CameraModelKind::pinhole);
+  EXPECT_EQ(from_message->pinhole.fx, 612.3);
+  EXPECT_EQ(from_message->pinhole.cy, 241.7);
+  EXPECT_EQ(from_message->pinhole.distortion[4], -0.013);
+  EXPECT_LT(vision::projection_difference_px(*from_message, *from_message), 1e-6);
+
+  CameraDescription longer = *from_message;
+  longer.pinhole.fx *= 1.005;
+  longer.pinhole.fy *= 1.005;
+  const double apart = vision::projection_difference_px(*from_message, longer);
+  std::cout << "0.5 % longer focal length: " << apart << " px apart\n";
+  EXPECT_GT(apart, 1.0);
+  EXPECT_LT(apart, 3.0);
+  CameraDescription smaller = *from_message;
+  smaller.width = 320;
+  EXPECT_TRUE(std::isinf(vision::projection_difference_px(*from_message, smaller)));
+
+  CameraInfo fish = info;
+  fish.distortion_model = "equidistant";
+  fish.d = {0.034, -0.0041, 0.00062, -0.00009};
+  const auto kb = camera_from_info(fish, "/omni/camera_info");
+  ASSERT_TRUE(kb);
+  EXPECT_EQ(kb->model, CameraModelKind::kannala_brandt);
+  EXPECT_LT(vision::projection_difference_px(*kb, *kb), 1e-6);
+
+  CameraInfo uncalibrated = info;
+  uncalibrated.k = {};
+  EXPECT_FALSE(camera_from_info(uncalibrated, "/ceiling/camera_info"));
+  CameraInfo unknown = info;
+  unknown.distortion_model = "double_sphere";
+  try {
+    camera_from_info(unknown, "/ceiling/camera_info");
+    ADD_FAILURE() << "an unknown model was read";
+  } catch (const InputError& e) {
+    EXPECT_THAT(e.what(), HasSubstr("/ceiling/camera_info"));
+    EXPECT_THAT(e.what(), HasSubstr("ceiling_optical"));
+    EXPECT_THAT(e.what(), HasSubstr("double_sphere"));
+  }
 }
 
 TEST(Calibration, KalibrCamchainWithBothCameras) {

@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "lampnav/core/error.hpp"
 
@@ -315,6 +316,43 @@ double ceiling_view_length(const CameraDescription& camera, double height) {
     return lo;
   };
   return reach(+1.0) + reach(-1.0);
+}
+
+double projection_difference_px(const CameraDescription& a, const CameraDescription& b) {
+  if (a.width != b.width || a.height != b.height) return std::numeric_limits<double>::infinity();
+  // Either model as a ray and back: pinhole cameras by PinholeCamera, fisheyes (Kannala-Brandt
+  // too, whose rays may pass 90 degrees) by FisheyeCamera.
+  struct Model {
+    std::optional<PinholeCamera> pinhole;
+    std::optional<FisheyeCamera> fisheye;
+    explicit Model(const CameraDescription& c) {
+      if (c.model == CameraModelKind::pinhole)
+        pinhole.emplace(c);
+      else
+        fisheye.emplace(c);
+    }
+    std::optional<Vector3d> ray(const Eigen::Vector2d& px) const {
+      if (pinhole) return pinhole->unproject(px);
+      return fisheye->unproject(px);
+    }
+    std::optional<Eigen::Vector2d> pixel(const Vector3d& ray) const {
+      return pinhole ? pinhole->project(ray) : fisheye->project(ray);
+    }
+  };
+  const Model ma(a), mb(b);
+  constexpr int kSteps = 16;
+  double worst = 0;
+  for (int i = 0; i <= kSteps; ++i)
+    for (int j = 0; j <= kSteps; ++j) {
+      const Eigen::Vector2d px((a.width - 1) * double(i) / kSteps,
+                               (a.height - 1) * double(j) / kSteps);
+      const auto ray = ma.ray(px);
+      if (!ray) continue;
+      const auto there = mb.pixel(*ray);
+      if (!there) return std::numeric_limits<double>::infinity();
+      worst = std::max(worst, (*there - px).norm());
+    }
+  return worst;
 }
 
 }  // namespace lampnav::vision

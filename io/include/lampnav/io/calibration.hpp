@@ -12,12 +12,15 @@
 // terms, a skewed or non-finite matrix) is refused with InputError naming the file, the camera
 // and the field.
 
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "lampnav/core/robot_description.hpp"
 
 namespace lampnav::io {
+
+struct CameraInfo;
 
 struct ImportedCamera {
   CameraDescription camera;  // name: see `label`; mount left zero
@@ -29,5 +32,10 @@ struct ImportedCamera {
 std::vector<ImportedCamera> read_calibration(const std::string& path);
 // The same from the file's text; `source` names it in messages.
 std::vector<ImportedCamera> parse_calibration(const std::string& text, const std::string& source);
+// The camera a sensor_msgs/msg/CameraInfo describes (a bag's, a live camera's), read as its
+// YAML is; nullopt when the driver publishes it uncalibrated (all of K zero). `source` names
+// the topic in messages.
+std::optional<CameraDescription> camera_from_info(const CameraInfo& info,
+                                                  const std::string& source);
 
 }  // namespace lampnav::io

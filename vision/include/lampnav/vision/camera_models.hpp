@@ -118,4 +118,11 @@ class FisheyeCamera {
 // line through the camera, for a ceiling `height` (m above the floor). 0 when it sees none.
 double ceiling_view_length(const CameraDescription& camera, double height);
 
+// How far apart (px) two descriptions of one camera put the same rays: the largest distance
+// between `a`'s pixels on a 17 x 17 grid over its image (those whose ray it knows) and where `b`
+// projects those rays. Infinity when the image sizes differ or `b` cannot see one of the rays.
+// Tells a robot.json from the calibration a camera driver publishes (its CameraInfo), whatever
+// the models' parameters.
+double projection_difference_px(const CameraDescription& a, const CameraDescription& b);
+
 }  // namespace lampnav::vision
