@@ -19,6 +19,7 @@ namespace lampnav::io {
 struct MissionLog;
 struct BagTopics;
 struct FrameTransform;
+struct CameraInfo;
 }  // namespace lampnav::io
 
 namespace lampnav::apps {
@@ -78,6 +79,13 @@ std::vector<std::string> mounts_from_tf(
     const std::vector<io::FrameTransform>& transforms,
     const std::function<std::string(const CameraDescription&)>& frame_of, const std::string& source,
     const std::string& what, RobotDescription& robot, bool quiet = false);
+
+// Whether robot.json's `camera` is the camera its driver describes (a CameraInfo from `source`,
+// a bag's topic or a live one): "" when they put every pixel of a grid over the image within
+// 1 px of each other, else a warning's text (what differs, and what to do). An uncalibrated
+// CameraInfo (K all zero) is not compared; one lampnav cannot read is said so.
+std::string camera_info_disagreement(const CameraDescription& camera, const io::CameraInfo& info,
+                                     const std::string& source);
 
 // X,Y,YAW (m, m, rad) from a command-line option; InputError naming `flag` otherwise.
 Pose2 parse_pose_option(const std::string& text, const std::string& flag);

@@ -15,7 +15,9 @@
 #include "commands.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/internal/json_util.hpp"
+#include "lampnav/io/calibration.hpp"
 #include "lampnav/io/mission_log.hpp"
+#include "lampnav/vision/camera_models.hpp"
 
 namespace lampnav::apps {
 void diagnostic(const std::string& kind, const std::string& text) {
@@ -132,6 +134,43 @@ std::vector<std::string> mounts_from_tf(
   return taken;
 }
 
+std::string camera_info_disagreement(const CameraDescription& camera, const io::CameraInfo& info,
+                                     const std::string& source) {
+  std::optional<CameraDescription> theirs;
+  try {
+    theirs = io::camera_from_info(info, source);
+  } catch (const InputError& e) {
+    return source + " describes " + camera.name + " in a way lampnav does not read (" +
+           e.message() + "): robot.json's intrinsics were not checked against it";
+  }
+  if (!theirs) return "";  // uncalibrated: nothing to compare
+  std::ostringstream what;
+  if (theirs->width != camera.width || theirs->height != camera.height) {
+    what << "its images are " << theirs->width << " x " << theirs->height << " px, robot.json's "
+         << camera.name << " " << camera.width << " x " << camera.height;
+  } else {
+    double apart = 0;
+    try {
+      apart = vision::projection_difference_px(camera, *theirs);
+    } catch (const Error& e) {
+      return source + " describes " + camera.name + " in a way lampnav does not read (" + e.what() +
+             "): robot.json's intrinsics were not checked against it";
+    }
+    if (apart <= 1.0) return "";
+    what << std::setprecision(3) << "its calibration (" << info.distortion_model << ", fx "
+         << info.k[0] << ") puts pixels ";
+    if (std::isfinite(apart))
+      what << "up to " << apart << " px";
+    else
+      what << "out of view";
+    what << " from where robot.json's " << camera.name << " (" << to_string(camera.model)
+         << ") puts them";
+  }
+  return source + ": " + what.str() +
+         ": robot.json is not this camera's calibration; if the camera's is right, import it "
+         "(lampnav robot import, docs/cli.md)";
+}
+
 io::MissionLog read_log_for_cameras(const std::string& log_path, const std::string& robot_path,
                                     const io::BagTopics& topics, RobotDescription& robot,
                                     std::string* robot_text) {
@@ -140,6 +179,7 @@ io::MissionLog read_log_for_cameras(const std::string& log_path, const std::stri
   if (log.ros2_bag) {
     for (const auto& n : log.notes) diagnostic("note", log_path + ": " + n);
     const auto first_frame = [&](const CameraDescription& c) {
+      if (c.name != "ceiling_camera" && c.name != "omni_camera") return std::string();
       const auto& frames = c.name == "ceiling_camera" ? log.ceiling_images : log.omni_images;
       return frames.empty() ? std::string() : frames.front().value.frame_id;
     };
@@ -148,6 +188,15 @@ io::MissionLog read_log_for_cameras(const std::string& log_path, const std::stri
              .empty() &&
         robot_text)
       *robot_text = to_robot_json(robot);
+    // The bag's CameraInfo of each camera (by the frame its images are stamped with).
+    for (const auto& c : robot.cameras) {
+      const std::string frame = first_frame(c);
+      for (const auto& [topic, info] : log.camera_info)
+        if (!frame.empty() && info.frame_id == frame) {
+          const std::string w = camera_info_disagreement(c, info, log_path + ": " + topic);
+          if (!w.empty()) diagnostic("warning", w);
+        }
+    }
   }
   return log;
 }

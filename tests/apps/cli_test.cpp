@@ -347,6 +347,12 @@ TEST(Cli, LocateFromAFrameOfALogOrABag) {
     const auto image = w.add_schema("sensor_msgs/msg/CompressedImage", "ros2msg",
                                     "std_msgs/Header header\nstring format\nuint8[] data\n");
     const auto omni = w.add_channel(image, "/fisheye/image_raw/compressed", "cdr");
+    // The driver's calibration of another camera (640 x 480): robot.json is not this camera's.
+    const auto info_schema = w.add_schema("sensor_msgs/msg/CameraInfo", "ros2msg", "");
+    const auto info = w.add_channel(info_schema, "/fisheye/camera_info", "cdr");
+    w.write(info, 2'300'000'000, 2'300'000'000,
+            test::camera_info_cdr(2'000'000'000, "omni_optical", 640, 480, "equidistant",
+                                  {0.01, 0, 0, 0}, 300, 300, 320, 240));
     w.write(omni, 2'300'000'000, 2'300'000'000,
             test::compressed_image_cdr(2'000'000'000, "omni_optical", "png", png));
     w.close();
@@ -363,6 +369,11 @@ TEST(Cli, LocateFromAFrameOfALogOrABag) {
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_DOUBLE_EQ(j["captured_s"].get<double>(), 2.0);
     EXPECT_THAT(j["image"].get<std::string>(), HasSubstr("omni frame captured at 2.000 s"));
+    if (input == bag) {  // said, not refused: the image is located as with robot.json alone
+      EXPECT_THAT(r.err,
+                  HasSubstr("/fisheye/camera_info: its images are 640 x 480 px, robot.json's "
+                            "omni_camera 1024 x 1024"));
+    }
     ASSERT_EQ(j["hypotheses"].size(), want.size());
     for (std::size_t k = 0; k < want.size(); ++k)
       for (const char* v : {"x", "y", "yaw_deg", "weight"})

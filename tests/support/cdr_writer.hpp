@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "cdr.hpp"
 
@@ -42,6 +43,22 @@ inline std::string odometry_cdr(std::int64_t stamp_ns, double x, double y, doubl
   w.f64(x).f64(y).f64(0).f64(0).f64(0).f64(std::sin(yaw / 2)).f64(std::cos(yaw / 2));
   for (int k = 0; k < 36; ++k) w.f64(0);
   for (int k = 0; k < 6 + 36; ++k) w.f64(0);
+  return w.data();
+}
+
+// sensor_msgs/msg/CameraInfo: a camera matrix [fx 0 cx; 0 fy cy; 0 0 1] and distortion `d` of
+// `model` (R the identity, P the camera matrix, no binning or region of interest), as a driver
+// publishes its calibration.
+inline std::string camera_info_cdr(std::int64_t stamp_ns, const std::string& frame,
+                                   std::uint32_t width, std::uint32_t height,
+                                   const std::string& model, const std::vector<double>& d,
+                                   double fx, double fy, double cx, double cy, bool little = true) {
+  CdrWriter w(little);
+  w.header(stamp_ns, frame).u32(height).u32(width).string(model).f64s(d);
+  for (double k : {fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0}) w.f64(k);
+  for (int k = 0; k < 9; ++k) w.f64(k % 4 == 0 ? 1.0 : 0.0);
+  for (double p : {fx, 0.0, cx, 0.0, 0.0, fy, cy, 0.0, 0.0, 0.0, 1.0, 0.0}) w.f64(p);
+  w.u32(0).u32(0).u32(0).u32(0).u32(0).u32(0).u8(0);
   return w.data();
 }
 
