@@ -198,23 +198,49 @@ std::vector<std::string> mounts_from_static_tf(ros::RosRobot& ros_robot, const N
       "node", t.tf_static, robot, a.quiet);
 }
 
-// Once running, the mounts are not changed: a camera whose mount on /tf_static came or changed
-// after the start (robot_state_publisher started late, a URDF edited) is told once, with what to
-// do. Damaged /tf_static messages are reported here too.
-void check_late_mounts(ros::RosRobot& ros_robot, const NodeArgs& a, const RobotDescription& robot,
-                       std::vector<std::string>& warned) {
+// What the node has told of its cameras' descriptions while running (each thing once).
+struct CameraChecks {
+  std::vector<std::string> late_mounts;      // cameras warned of
+  std::optional<io::CameraInfo> checked[2];  // ceiling, omni: the CameraInfo checked
+};
+
+bool same_calibration(const io::CameraInfo& a, const io::CameraInfo& b) {
+  return a.width == b.width && a.height == b.height && a.distortion_model == b.distortion_model &&
+         a.d == b.d && a.k == b.k;
+}
+
+// Every second while running. Once running, the mounts are not changed: a camera whose mount on
+// /tf_static came or changed after the start (robot_state_publisher started late, a URDF edited)
+// is told once, with what to do. Each camera's driver calibration (CameraInfo) is checked
+// against robot.json when it first comes and when it changes. Damaged /tf_static and camera_info
+// messages are reported here too.
+void check_cameras(ros::RosRobot& ros_robot, const NodeArgs& a, const RobotDescription& robot,
+                   CameraChecks& done) {
   const std::vector<io::FrameTransform> transforms = ros_robot.static_transforms();
-  for (const auto& [role, name] : cameras_in_use(a.robot_options.topics)) {
+  const ros::NodeTopics& t = a.robot_options.topics;
+  for (const auto& [role, name] : cameras_in_use(t)) {
     const CameraDescription* c = robot.find_camera(name);
+    if (!c) continue;
+    std::optional<io::CameraInfo>& checked = done.checked[role == CameraRole::omni];
+    if (const auto info = ros_robot.camera_info(role);
+        info && !(checked && same_calibration(*checked, *info))) {
+      checked = info;
+      const std::string w = camera_info_disagreement(
+          *c, *info,
+          ros::camera_info_topic(role == CameraRole::ceiling ? t.ceiling_image : t.omni_image));
+      if (!w.empty()) diagnostic("warning", w);
+    }
     const std::string frame = ros_robot.camera_frame(role);
-    if (!c || frame.empty() || std::count(warned.begin(), warned.end(), name)) continue;
+    if (t.tf_static.empty() || frame.empty() ||
+        std::count(done.late_mounts.begin(), done.late_mounts.end(), name))
+      continue;
     const auto m = io::mount_from_tf(transforms, frame);
     // Compared as rotations: roll, pitch and yaw wrap.
     if (!m || ((m->xyz - c->mount.xyz).norm() < 1e-3 &&
                (Mount{m->xyz, m->rpy}.rotation() - c->mount.rotation()).norm() < 1e-3))
       continue;
-    warned.push_back(name);
-    diagnostic("warning", name + "'s mount on " + a.robot_options.topics.tf_static +
+    done.late_mounts.push_back(name);
+    diagnostic("warning", name + "'s mount on " + t.tf_static +
                               " came or changed after the node started (" + m->base + " -> " +
                               frame + "): the node goes on with the mount it started with; " +
                               "restart it to take the new one");
@@ -257,7 +283,7 @@ int run_node(NodeArgs& a) {
   std::thread watcher([&] {
     ros::NodeCounts reported;
     bool counting = false;  // images dropped while the node waited for the mounts are not news
-    std::vector<std::string> warned;
+    CameraChecks checks;
     for (int tick = 1; !done; ++tick) {
       if (g_stop) ros_robot.stop();
       if (!counting && looping) {
@@ -266,8 +292,7 @@ int run_node(NodeArgs& a) {
         tick = 1;
       }
       // Every second; `robot` is the node's own from the start on.
-      if (counting && tick % 20 == 0 && !ro.topics.tf_static.empty())
-        check_late_mounts(ros_robot, a, robot, warned);
+      if (counting && tick % 20 == 0) check_cameras(ros_robot, a, robot, checks);
       if (counting && !a.quiet && tick % 100 == 0) {  // every 5 s: images dropped since then
         const ros::NodeCounts c = ros_robot.counts();
         const std::uint64_t ceiling = c.ceiling.dropped - reported.ceiling.dropped,
@@ -357,6 +382,7 @@ int run_node(NodeArgs& a) {
         {"commands", counts_json(c.commands)},
         {"pose_estimates", counts_json(c.pose_estimates)},
         {"static_transforms", counts_json(c.static_transforms)},
+        {"camera_info", counts_json(c.camera_info)},
         {"mounts_from_tf", tf_mounts},
         {"images_before_start", {{"ceiling", pub.before_start[0]}, {"omni", pub.before_start[1]}}},
         {"wheel_readings", out.wheel_readings},

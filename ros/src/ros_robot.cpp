@@ -92,7 +92,8 @@ struct Inbox {
   bool holding = false;                   // images kept, uncounted, until release_images()
   std::string ceiling_frame, omni_frame;  // the first image's header.frame_id
   std::vector<io::FrameTransform> static_transforms;
-  std::vector<std::string> problems;  // from /tf_static, not yet reported
+  std::vector<std::string> problems;  // from /tf_static and camera_info, not yet reported
+  std::optional<io::CameraInfo> ceiling_info, omni_info;
 
   std::size_t& waiting(InputKind kind) {
     return kind == InputKind::ceiling ? ceiling_waiting : omni_waiting;
@@ -207,6 +208,8 @@ RosRobot::RosRobot(Participant& p, const RosRobotOptions& options)
       subscribe(p, t.pose_estimate, "geometry_msgs/msg/PoseWithCovarianceStamped", Qos::state,
                 InputKind::pose_estimate);
     if (!t.tf_static.empty()) subscribe_static_transforms(p);
+    if (!t.ceiling_image.empty()) subscribe_camera_info(p, t.ceiling_image, CameraRole::ceiling);
+    if (!t.omni_image.empty()) subscribe_camera_info(p, t.omni_image, CameraRole::omni);
   } catch (...) {
     close();  // the subscriptions made so far stay with the participant
     throw;
@@ -281,42 +284,84 @@ void RosRobot::subscribe(Participant& p, const std::string& topic, const std::st
               });
 }
 
+namespace {
+
+// Subscribes a small message decoded as it comes, on the DDS thread: counted in the inbox's
+// `counts`; one that does not decode refused and kept to be reported (at most 100 until they
+// are); `take` keeps what decoded, the inbox's mutex held.
+template <class Value, class Take>
+void subscribe_decoded(Participant& p, const std::string& topic, const std::string& type, Qos qos,
+                       std::shared_ptr<detail::Inbox> inbox, InputCounts NodeCounts::*counts,
+                       Value (*decode)(const std::string&), Take take) {
+  p.subscribe(topic, type, qos, [inbox, topic, counts, decode, take](Sample&& s) {
+    std::optional<Value> value;
+    std::string problem;
+    try {
+      value = decode(s.cdr);
+    } catch (const io::CdrError& e) {
+      problem = e.what();
+    }
+    std::lock_guard<std::mutex> lock(inbox->mutex);
+    if (inbox->closed) return;
+    InputCounts& c = inbox->counts.*counts;
+    ++c.received;
+    if (!value) {
+      ++c.refused;
+      if (inbox->problems.size() < 100)
+        inbox->problems.push_back(topic + ", message " + std::to_string(s.sequence) + ": " +
+                                  problem);
+      return;
+    }
+    ++c.used;
+    take(*inbox, std::move(*value));
+  });
+}
+
+}  // namespace
+
 void RosRobot::subscribe_static_transforms(Participant& p) {
-  // A few small messages, at start: decoded as they come, on the DDS thread.
-  p.subscribe(o_.topics.tf_static, "tf2_msgs/msg/TFMessage", Qos::tf_static,
-              [inbox = inbox_, topic = o_.topics.tf_static](Sample&& s) {
-                std::vector<io::FrameTransform> transforms;
-                std::string problem;
-                try {
-                  transforms = io::ros2::tf_transforms(s.cdr);
-                } catch (const io::CdrError& e) {
-                  problem = e.what();
-                }
-                std::lock_guard<std::mutex> lock(inbox->mutex);
-                if (inbox->closed) return;
-                InputCounts& c = inbox->counts.static_transforms;
-                ++c.received;
-                if (!problem.empty()) {
-                  ++c.refused;
-                  if (inbox->problems.size() < 100)  // until they are reported
-                    inbox->problems.push_back(topic + ", message " + std::to_string(s.sequence) +
-                                              ": " + problem);
-                  return;
-                }
-                ++c.used;
-                // The latest of each child frame (as mount_from_tf takes them), in place: a
-                // publisher that sends its transforms again and again takes no more memory.
-                for (auto& t : transforms) {
-                  t.is_static = true;
-                  auto& kept = inbox->static_transforms;
-                  const auto same = std::find_if(kept.begin(), kept.end(),
-                                                 [&](const auto& k) { return k.child == t.child; });
-                  if (same != kept.end())
-                    *same = std::move(t);
-                  else
-                    kept.push_back(std::move(t));
-                }
-              });
+  // A few small messages, at start. The latest of each child frame is kept (as mount_from_tf
+  // takes them), in place: a publisher that sends its transforms again and again takes no more
+  // memory.
+  subscribe_decoded(p, o_.topics.tf_static, "tf2_msgs/msg/TFMessage", Qos::tf_static, inbox_,
+                    &NodeCounts::static_transforms, &io::ros2::tf_transforms,
+                    [](detail::Inbox& inbox, std::vector<io::FrameTransform> transforms) {
+                      auto& kept = inbox.static_transforms;
+                      for (auto& t : transforms) {
+                        t.is_static = true;
+                        const auto same =
+                            std::find_if(kept.begin(), kept.end(),
+                                         [&](const auto& k) { return k.child == t.child; });
+                        if (same != kept.end())
+                          *same = std::move(t);
+                        else
+                          kept.push_back(std::move(t));
+                      }
+                    });
+}
+
+std::string camera_info_topic(const std::string& image_topic) {
+  std::string base = image_topic;
+  if (ends_with(base, "/compressed")) base.erase(base.size() - 11);
+  const auto slash = base.rfind('/');
+  return (slash == std::string::npos || slash == 0 ? std::string() : base.substr(0, slash)) +
+         "/camera_info";
+}
+
+void RosRobot::subscribe_camera_info(Participant& p, const std::string& image_topic,
+                                     CameraRole camera) {
+  // As often as the images; the newest kept.
+  subscribe_decoded(p, camera_info_topic(image_topic), "sensor_msgs/msg/CameraInfo",
+                    Qos::sensor_data, inbox_, &NodeCounts::camera_info, &io::ros2::camera_info,
+                    [camera](detail::Inbox& inbox, io::CameraInfo info) {
+                      (camera == CameraRole::ceiling ? inbox.ceiling_info : inbox.omni_info) =
+                          std::move(info);
+                    });
+}
+
+std::optional<io::CameraInfo> RosRobot::camera_info(CameraRole camera) const {
+  std::lock_guard<std::mutex> lock(inbox_->mutex);
+  return camera == CameraRole::ceiling ? inbox_->ceiling_info : inbox_->omni_info;
 }
 
 void RosRobot::release_images() {

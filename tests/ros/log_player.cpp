@@ -8,6 +8,7 @@
 //                      [--wait-s S] [--loops N] [--jpeg QUALITY | --raw]
 //                      [--pose-estimate X,Y,YAW]   (sent on /initialpose after the first wheels)
 //                      [--tf-static]   (the log's camera mounts on /tf_static, transient local)
+//                      [--camera-info SCALE]   (the ceiling camera's CameraInfo, focal x SCALE)
 // Prints one line of counts; exit 0, 1 when no node answered, 2 for bad arguments.
 
 #include <atomic>
@@ -62,13 +63,32 @@ int main(int argc, char** argv) {
       p.writer("/omni_camera/image_raw" + suffix, image_type, ros::Qos::sensor_data);
   ros::Writer& estimate =
       p.writer("/initialpose", "geometry_msgs/msg/PoseWithCovarianceStamped", ros::Qos::state);
+  if ((o.tf_static || o.camera_info_scale > 0) && !log.robot_json) {
+    std::cerr << "lampnav_log_player: --tf-static, --camera-info: the log has no robot.json\n";
+    return 2;
+  }
+  const RobotDescription robot =
+      log.robot_json ? parse_robot_description(*log.robot_json, o.log) : RobotDescription{};
+  // The ceiling camera's calibration as its driver would publish it, with each image.
+  ros::Writer& info_writer =
+      p.writer("/ceiling_camera/camera_info", "sensor_msgs/msg/CameraInfo", ros::Qos::sensor_data);
+  const CameraDescription* ceiling_camera = robot.find_camera("ceiling_camera");
+  if (o.camera_info_scale > 0 &&
+      (!ceiling_camera || ceiling_camera->model != CameraModelKind::pinhole)) {
+    std::cerr << "lampnav_log_player: --camera-info: the log's ceiling camera is not a pinhole\n";
+    return 2;
+  }
+  const auto info_message = [&](Stamp stamp) {
+    const PinholeParameters& k = ceiling_camera->pinhole;
+    const double s = o.camera_info_scale;
+    return test::camera_info_cdr(to_nanoseconds(stamp), "ceiling_camera",
+                                 static_cast<std::uint32_t>(ceiling_camera->width),
+                                 static_cast<std::uint32_t>(ceiling_camera->height), "plumb_bob",
+                                 std::vector<double>(k.distortion.begin(), k.distortion.end()),
+                                 k.fx * s, k.fy * s, k.cx, k.cy);
+  };
   if (o.tf_static) {
     // Written now, before the node is matched: DDS keeps it for readers that come later.
-    if (!log.robot_json) {
-      std::cerr << "lampnav_log_player: --tf-static: the log has no robot.json\n";
-      return 2;
-    }
-    const RobotDescription robot = parse_robot_description(*log.robot_json, o.log);
     std::vector<io::FrameTransform> mounts;
     for (const auto& c : robot.cameras) {
       io::FrameTransform t;
@@ -148,6 +168,7 @@ int main(int argc, char** argv) {
       } else {
         const auto& f = (kind == 1 ? log.ceiling_images : log.omni_images)[it.index].value;
         const char* frame = kind == 1 ? "ceiling_camera" : "omni_camera";
+        if (kind == 1 && o.camera_info_scale > 0) info_writer.write(info_message(f.stamp + shift));
         ok = (kind == 1 ? ceiling : omni)
                  .write(o.raw ? image_message(f.stamp + shift, frame,
                                               (kind == 1 ? raw_ceiling : raw_omni)[it.index])

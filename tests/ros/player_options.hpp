@@ -20,6 +20,10 @@ struct PlayerOptions {
   // The cameras' mounts of the log's robot.json sent on /tf_static (base_footprint -> each
   // camera's frame), once, before any node is there (transient local, as robot_state_publisher).
   bool tf_static = false;
+  // > 0: the ceiling camera's calibration of the log's robot.json (a pinhole) sent as
+  // sensor_msgs/msg/CameraInfo on /ceiling_camera/camera_info with each of its images, its focal
+  // lengths times this (1: the robot.json's own).
+  double camera_info_scale = 0;
   double rate = 1, wheel_radius = 0.1, wait_s = 20, linger_s = 3;
   // An operator's "2D Pose Estimate" (x, y, yaw) sent on /initialpose after the first wheels.
   std::optional<Pose2> pose_estimate;
@@ -56,6 +60,8 @@ inline PlayerOptions parse_player_options(int argc, char** argv) {
       o.raw = true;
     else if (a == "--tf-static")
       o.tf_static = true;
+    else if (a == "--camera-info")
+      o.camera_info_scale = number(k);
     else if (a == "--pose-estimate" && k + 1 < argc) {
       double x = 0, y = 0, yaw = 0;
       char tail = 0;

@@ -72,6 +72,19 @@ Taken take_inputs(RosRobot& robot, const std::function<bool(const Taken&)>& enou
   return taken;
 }
 
+// A robot with the ceiling camera alone on compressed images, a stand-in for its drivers on the
+// same domain, and the problems the robot reported.
+struct CeilingRig {
+  int domain = test::test_domain();
+  Participant node_side{domain}, drivers{domain};
+  RosRobotOptions o = ceiling_camera_only("/ceiling_camera/image_raw/compressed");
+  RosRobot robot{node_side, o};
+  std::vector<std::string> problems;
+  CeilingRig() {
+    robot.on_problem = [this](const std::string& p) { problems.push_back(p); };
+  }
+};
+
 TEST(RosRobot, TakesInputsRefusesDamagedOnesAndPublishes) {
   const int domain = test::test_domain();
   Participant node_side(domain), drivers(domain);
@@ -327,12 +340,11 @@ TEST(RosRobot, HoldsEveryImageUntilReleased) {
 // size at start: each comes out as its bytes decode, in arrival order; a damaged one is reported
 // with its topic and number and the next one taken.
 TEST(RosRobot, DecodesCompressedImagesOnTheCamerasThread) {
-  const int domain = test::test_domain();
-  Participant node_side(domain), drivers(domain);
-  const RosRobotOptions o = ceiling_camera_only("/ceiling_camera/image_raw/compressed");
-  RosRobot robot(node_side, o);
-  std::vector<std::string> problems;
-  robot.on_problem = [&](const std::string& p) { problems.push_back(p); };
+  CeilingRig rig;
+  Participant& drivers = rig.drivers;
+  const RosRobotOptions& o = rig.o;
+  RosRobot& robot = rig.robot;
+  std::vector<std::string>& problems = rig.problems;
   Writer& camera =
       drivers.writer(o.topics.ceiling_image, "sensor_msgs/msg/CompressedImage", Qos::sensor_data);
   ASSERT_TRUE(test::wait_for([&] { return camera.matched(); }));
@@ -462,6 +474,39 @@ TEST(RosRobot, TakesStaticTransformsAndTheCamerasFrame) {
   EXPECT_EQ(mount->base, "base_footprint");
   EXPECT_NEAR((mount->xyz - Eigen::Vector3d(0.2, 0, 0.4)).norm(), 0, 1e-12);
   EXPECT_NEAR((mount->rpy - Eigen::Vector3d(0, 0, M_PI / 2)).norm(), 0, 1e-12);
+}
+
+// A camera's calibration as its driver publishes it, beside its images (image_transport's
+// naming): the newest one kept; a damaged one refused naming the topic and the message.
+TEST(RosRobot, TakesEachCamerasCalibrationBesideItsImages) {
+  EXPECT_EQ(camera_info_topic("/ceiling_camera/image_raw/compressed"),
+            "/ceiling_camera/camera_info");
+  EXPECT_EQ(camera_info_topic("/fisheye/image_raw"), "/fisheye/camera_info");
+  EXPECT_EQ(camera_info_topic("/image_raw"), "/camera_info");
+  CeilingRig rig;
+  Participant& drivers = rig.drivers;
+  RosRobot& robot = rig.robot;
+  std::vector<std::string>& problems = rig.problems;
+  Writer& info = drivers.writer("/ceiling_camera/camera_info", "sensor_msgs/msg/CameraInfo",
+                                Qos::state);  // a reliable publisher: the reader takes it too
+  ASSERT_TRUE(test::wait_for([&] { return info.matched(); }));
+  EXPECT_FALSE(robot.camera_info(CameraRole::ceiling));
+  for (const double fx : {300.0, 303.0})
+    ASSERT_TRUE(
+        info.write(test::camera_info_cdr(1'000'000'000, "ceiling_camera", 352, 288, "plumb_bob",
+                                         {-0.12, 0.02, 0, 0, 0}, fx, fx, 175.5, 143.5)));
+  const std::string whole = test::camera_info_cdr(1'000'000'000, "ceiling_camera", 352, 288,
+                                                  "plumb_bob", {}, 300, 300, 175.5, 143.5);
+  ASSERT_TRUE(info.write(whole.substr(0, 60)));
+  ASSERT_TRUE(test::wait_for([&] { return robot.counts().camera_info.received == 3; }));
+  const auto newest = robot.camera_info(CameraRole::ceiling);
+  ASSERT_TRUE(newest);
+  EXPECT_EQ(newest->k[0], 303.0);
+  EXPECT_EQ(newest->width, 352);
+  EXPECT_EQ(robot.counts().camera_info.refused, 1u);
+  robot.static_transforms();  // reports what was refused
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_THAT(problems[0], HasSubstr("/ceiling_camera/camera_info, message 3"));
 }
 
 }  // namespace

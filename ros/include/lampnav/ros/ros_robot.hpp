@@ -49,6 +49,10 @@ struct NodeTopics {
   std::string ns = "/lampnav";
 };
 
+// A camera's calibration topic beside its images, as image_transport names it:
+// "/ceiling_camera/image_raw/compressed" -> "/ceiling_camera/camera_info".
+std::string camera_info_topic(const std::string& image_topic);
+
 // REP-105 frames.
 struct NodeFrames {
   std::string map = "map", odom = "odom", base = "base_link";
@@ -86,7 +90,7 @@ struct InputCounts {
 };
 
 struct NodeCounts {
-  InputCounts ceiling, omni, odometry, commands, pose_estimates, static_transforms;
+  InputCounts ceiling, omni, odometry, commands, pose_estimates, static_transforms, camera_info;
   std::uint64_t poses_published = 0;
 };
 
@@ -113,14 +117,18 @@ class RosRobot : public Robot {
   Clock::time_point last_arrival() const { return last_arrival_; }
   Clock::time_point last_ready() const { return last_ready_; }
   NodeCounts counts() const;
+  // The newest sensor_msgs/msg/CameraInfo of `camera` (its driver's calibration, on the
+  // camera_info topic beside its images: /a/image_raw[/compressed] -> /a/camera_info); nullopt
+  // while none has come. Damaged ones are reported through on_problem by static_transforms().
+  std::optional<io::CameraInfo> camera_info(CameraRole camera) const;
   // Ends hold_images: from now on each camera's waiting images are bounded.
   void release_images();
   // The frame_id of the first image of `camera` that came (before it is decoded); empty while
   // none has.
   std::string camera_frame(CameraRole camera) const;
   // The transforms that came on /tf_static so far, the latest of each child frame, in the order
-  // the frames first came. Messages that did not decode are counted, and reported through
-  // on_problem by this call.
+  // the frames first came. Messages of /tf_static and camera_info that did not decode are
+  // counted, and reported through on_problem by this call.
   std::vector<io::FrameTransform> static_transforms();
   // Called for each message refused, with the reason (topic, message number, field).
   std::function<void(const std::string&)> on_problem;
@@ -130,6 +138,7 @@ class RosRobot : public Robot {
   void subscribe(Participant& p, const std::string& topic, const std::string& type, Qos qos,
                  detail::InputKind kind);
   void subscribe_static_transforms(Participant& p);
+  void subscribe_camera_info(Participant& p, const std::string& image_topic, CameraRole camera);
   const std::string& topic_of(detail::InputKind kind) const;
   // Closes the inbox: its callbacks drop what comes from then on; the decoding threads finish.
   void close();
