@@ -136,26 +136,26 @@ std::vector<std::string> mounts_from_tf(
 
 std::string camera_info_disagreement(const CameraDescription& camera, const io::CameraInfo& info,
                                      const std::string& source) {
+  const auto not_read = [&](const std::string& why) {
+    return source + " describes " + camera.name + " in a way lampnav does not read (" + why +
+           "): robot.json's intrinsics were not checked against it";
+  };
   std::optional<CameraDescription> theirs;
+  double apart = 0;
   try {
     theirs = io::camera_from_info(info, source);
-  } catch (const InputError& e) {
-    return source + " describes " + camera.name + " in a way lampnav does not read (" +
-           e.message() + "): robot.json's intrinsics were not checked against it";
+    if (!theirs) return "";  // uncalibrated: nothing to compare
+    apart = vision::projection_difference_px(camera, *theirs);
+  } catch (const InputError& e) {  // a model lampnav does not read
+    return not_read(e.message());
+  } catch (const Error& e) {  // or cannot project through
+    return not_read(e.what());
   }
-  if (!theirs) return "";  // uncalibrated: nothing to compare
   std::ostringstream what;
   if (theirs->width != camera.width || theirs->height != camera.height) {
     what << "its images are " << theirs->width << " x " << theirs->height << " px, robot.json's "
          << camera.name << " " << camera.width << " x " << camera.height;
   } else {
-    double apart = 0;
-    try {
-      apart = vision::projection_difference_px(camera, *theirs);
-    } catch (const Error& e) {
-      return source + " describes " + camera.name + " in a way lampnav does not read (" + e.what() +
-             "): robot.json's intrinsics were not checked against it";
-    }
     if (apart <= 1.0) return "";
     what << std::setprecision(3) << "its calibration (" << info.distortion_model << ", fx "
          << info.k[0] << ") puts pixels ";
@@ -191,11 +191,12 @@ io::MissionLog read_log_for_cameras(const std::string& log_path, const std::stri
     // The bag's CameraInfo of each camera (by the frame its images are stamped with).
     for (const auto& c : robot.cameras) {
       const std::string frame = first_frame(c);
+      if (frame.empty()) continue;
       for (const auto& [topic, info] : log.camera_info)
-        if (!frame.empty() && info.frame_id == frame) {
-          const std::string w = camera_info_disagreement(c, info, log_path + ": " + topic);
-          if (!w.empty()) diagnostic("warning", w);
-        }
+        if (info.frame_id == frame)
+          if (const std::string w = camera_info_disagreement(c, info, log_path + ": " + topic);
+              !w.empty())
+            diagnostic("warning", w);
     }
   }
   return log;

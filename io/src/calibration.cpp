@@ -335,12 +335,12 @@ std::optional<CameraDescription> camera_from_info(const CameraInfo& info,
   if (std::all_of(info.k.begin(), info.k.end(), [](double v) { return v == 0; }))
     return std::nullopt;
   const Where w{source, info.frame_id};
-  for (const auto& [values, field] :
-       {std::pair{std::vector<double>(info.k.begin(), info.k.end()), "k"}, std::pair{info.d, "d"}})
-    if (!std::all_of(values.begin(), values.end(), [](double v) { return std::isfinite(v); }))
+  const std::vector<double> K(info.k.begin(), info.k.end());
+  for (const auto& [values, field] : {std::pair{&K, "k"}, std::pair{&info.d, "d"}})
+    if (!std::all_of(values->begin(), values->end(), [](double v) { return std::isfinite(v); }))
       w.fail(field, "holds a number that is not finite");
   double fx, fy, cx, cy;
-  from_matrix(std::vector<double>(info.k.begin(), info.k.end()), "k", w, fx, fy, cx, cy);
+  from_matrix(K, "k", w, fx, fy, cx, cy);
   if (info.width <= 0 || info.height <= 0 || info.width > 100000 || info.height > 100000)
     w.fail("width", "the image size must be 1 to 100000 px each way");
   return camera(info.distortion_model, info.d, fx, fy, cx, cy, info.width, info.height, "d", w);

@@ -299,13 +299,19 @@ std::string pose_array(Stamp stamp, const std::string& frame, const std::vector<
 }
 
 std::string tf_message(const std::vector<Transform>& transforms) {
-  CdrWriter w;
-  w.u32(static_cast<std::uint32_t>(transforms.size()));
+  std::vector<FrameTransform> spatial;
+  spatial.reserve(transforms.size());
   for (const auto& t : transforms) {
-    w.header(ns(t.stamp), t.parent).string(t.child);
-    pose(w, t.pose);  // translation and rotation: the same five doubles as a pose
+    FrameTransform f;
+    f.stamp = t.stamp;
+    f.parent = t.parent;
+    f.child = t.child;
+    f.translation = {t.pose.x(), t.pose.y(), 0};
+    // About z: written as pose() writes an orientation, (0, 0, sin, cos) of half the yaw.
+    f.rotation = Eigen::Quaterniond(std::cos(t.pose.yaw() / 2), 0, 0, std::sin(t.pose.yaw() / 2));
+    spatial.push_back(std::move(f));
   }
-  return w.take();
+  return tf_message(spatial);
 }
 
 std::string tf_message(const std::vector<FrameTransform>& transforms) {

@@ -283,22 +283,39 @@ std::optional<Vector3d> FisheyeCamera::unproject(const Vector2d& px) const {
                   std::cos(*theta));
 }
 
+namespace {
+
+// Either model, from ray to pixel and back: pinhole cameras by PinholeCamera, fisheyes
+// (Kannala-Brandt too, whose rays may pass 90 degrees) by FisheyeCamera.
+struct AnyCamera {
+  std::optional<PinholeCamera> pinhole;
+  std::optional<FisheyeCamera> fisheye;
+  explicit AnyCamera(const CameraDescription& c) {
+    if (c.model == CameraModelKind::pinhole)
+      pinhole.emplace(c);
+    else
+      fisheye.emplace(c);
+  }
+  std::optional<Vector3d> ray(const Eigen::Vector2d& px) const {
+    if (pinhole) return pinhole->unproject(px);
+    return fisheye->unproject(px);
+  }
+  std::optional<Eigen::Vector2d> pixel(const Vector3d& ray) const {
+    return pinhole ? pinhole->project(ray) : fisheye->project(ray);
+  }
+};
+
+}  // namespace
+
 double ceiling_view_length(const CameraDescription& camera, double height) {
   const Eigen::Matrix3d R = camera.mount.rotation();
   const Vector3d origin = camera.mount.xyz;
   if (!(height > origin.z())) return 0.0;
-  std::optional<PinholeCamera> pinhole;
-  std::optional<FisheyeCamera> fisheye;
-  if (camera.model == CameraModelKind::pinhole) {
-    pinhole.emplace(camera);
-  } else {
-    fisheye.emplace(camera);
-  }
+  const AnyCamera model(camera);
   auto visible = [&](double s) {
     const Vector3d p_base(origin.x() + s, origin.y(), height);
-    const Vector3d p_cam = R.transpose() * (p_base - origin);
-    const auto px = pinhole ? pinhole->project(p_cam) : fisheye->project(p_cam);
-    return px && (pinhole ? pinhole->in_image(*px) : fisheye->in_image(*px));
+    const auto px = model.pixel(R.transpose() * (p_base - origin));
+    return px && vision::in_image(*px, camera.width, camera.height);
   };
   if (!visible(0.0)) return 0.0;
   // Walk out each way to the edge of the view, then bisect the edge.
@@ -320,26 +337,7 @@ double ceiling_view_length(const CameraDescription& camera, double height) {
 
 double projection_difference_px(const CameraDescription& a, const CameraDescription& b) {
   if (a.width != b.width || a.height != b.height) return std::numeric_limits<double>::infinity();
-  // Either model as a ray and back: pinhole cameras by PinholeCamera, fisheyes (Kannala-Brandt
-  // too, whose rays may pass 90 degrees) by FisheyeCamera.
-  struct Model {
-    std::optional<PinholeCamera> pinhole;
-    std::optional<FisheyeCamera> fisheye;
-    explicit Model(const CameraDescription& c) {
-      if (c.model == CameraModelKind::pinhole)
-        pinhole.emplace(c);
-      else
-        fisheye.emplace(c);
-    }
-    std::optional<Vector3d> ray(const Eigen::Vector2d& px) const {
-      if (pinhole) return pinhole->unproject(px);
-      return fisheye->unproject(px);
-    }
-    std::optional<Eigen::Vector2d> pixel(const Vector3d& ray) const {
-      return pinhole ? pinhole->project(ray) : fisheye->project(ray);
-    }
-  };
-  const Model ma(a), mb(b);
+  const AnyCamera ma(a), mb(b);
   constexpr int kSteps = 16;
   double worst = 0;
   for (int i = 0; i <= kSteps; ++i)
