@@ -307,6 +307,11 @@ int main(int argc, char** argv) {
       std::nullopt, 2000.0, std::nullopt);
   add("omni frame decoding, 1024x1024, JPEG 90", us("BM_DecodeOmniFrame/90"),
       "PNG of the same frames", us("BM_DecodeOmniFrame/0"), std::nullopt, std::nullopt);
+  int raw = 0;
+  for (const char* encoding : {"mono8", "bgr8", "yuyv", "bayer_rggb8"})
+    add(std::string("omni frame made grey, 1024x1024, raw ") + encoding,
+        us("BM_ReadRawOmniFrame/" + std::to_string(raw++)), "JPEG 90 decoding",
+        us("BM_DecodeOmniFrame/90"), std::nullopt, std::nullopt);
   add("EKF predict", us("BM_EkfPredict"), "", std::nullopt, 0.1, std::nullopt);
   const auto pu = us("BM_EkfPredictAndGatedUpdate"), pr = us("BM_EkfPredict");
   add("EKF gated update (predict + update minus predict)",

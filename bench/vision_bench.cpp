@@ -13,9 +13,11 @@
 #include <opencv2/features2d.hpp>
 #include <random>
 
+#include "cdr_writer.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/image_encoding.hpp"
 #include "lampnav/io/mission_log.hpp"
+#include "lampnav/io/ros2_messages.hpp"
 #include "lampnav/sim/renderers.hpp"
 #include "lampnav/vision/lamp_tracker.hpp"
 #include "lampnav/vision/omni_detector.hpp"
@@ -264,6 +266,37 @@ void BM_DecodeOmniFrame(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_DecodeOmniFrame)->Arg(0)->Arg(90)->Unit(benchmark::kMicrosecond);
+
+// An uncompressed 1024 x 1024 omni frame (sensor_msgs/msg/Image) made grey as the node does when
+// it arrives (io::ros2::raw_image_grey: the message read, its pixels converted): mono8, bgr8, a
+// webcam's yuyv and a Bayer mosaic (rggb8), each pixel the frame's grey level.
+void BM_ReadRawOmniFrame(benchmark::State& state) {
+  const OmniFrames& f = omni_frames();
+  struct Encoding {
+    const char* name;
+    int bytes;  // a pixel
+  };
+  constexpr Encoding kEncodings[] = {{"mono8", 1}, {"bgr8", 3}, {"yuyv", 2}, {"bayer_rggb8", 1}};
+  const Encoding& e = kEncodings[state.range(0)];
+  std::vector<std::string> messages;
+  for (const Image8& image : f.images) {
+    std::string rows(image.pixels.size() * e.bytes, '\0');
+    for (std::size_t k = 0; k < image.pixels.size(); ++k) {
+      const char v = static_cast<char>(image.pixels[k]);
+      for (int c = 0; c < e.bytes; ++c)
+        rows[k * e.bytes + c] = e.bytes == 2 && c == 1 ? '\x80' : v;  // yuyv: U and V neutral
+    }
+    messages.push_back(test::raw_image_cdr(0, "omni", e.name, image.width, image.height,
+                                           image.width * e.bytes, rows));
+  }
+  std::size_t k = 0;
+  for (auto _ : state) {
+    const io::ros2::GreyImage g = io::ros2::raw_image_grey(messages[k++ % messages.size()]);
+    benchmark::DoNotOptimize(g.image.pixels.data());
+  }
+  state.SetLabel(e.name);
+}
+BENCHMARK(BM_ReadRawOmniFrame)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 

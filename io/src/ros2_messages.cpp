@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "cdr.hpp"
+#include "raw_pixels.hpp"
 
 namespace lampnav::io::ros2 {
 
@@ -58,53 +59,15 @@ GreyImage raw_image_grey(const std::string& data) {
   GreyImage f;
   f.stamp = h.stamp;
   f.frame_id = h.frame_id;
-  const std::uint32_t height = r.u32("height"), width = r.u32("width");
-  const std::string encoding = r.string("encoding");
-  const bool big_endian = r.u8("is_bigendian") != 0;
-  const std::uint32_t step = r.u32("step");
+  detail::RawPixels raw;
+  raw.height = r.u32("height");
+  raw.width = r.u32("width");
+  raw.encoding = r.string("encoding");
+  raw.big_endian = r.u8("is_bigendian") != 0;
+  raw.step = r.u32("step");
   const std::string pixels = r.bytes("data");
-  int channels = 0, depth = 1;
-  if (encoding == "mono8" || encoding == "8UC1")
-    channels = 1;
-  else if (encoding == "mono16" || encoding == "16UC1")
-    channels = 1, depth = 2;
-  else if (encoding == "bgr8" || encoding == "rgb8" || encoding == "8UC3")
-    channels = 3;
-  else if (encoding == "bgra8" || encoding == "rgba8" || encoding == "8UC4")
-    channels = 4;
-  else
-    throw CdrError("encoding \"" + encoding +
-                   "\" is not read (mono8, mono16, bgr8, rgb8, bgra8, rgba8)");
-  if (width == 0 || height == 0 || width > 16384 || height > 16384)
-    throw CdrError("image size " + std::to_string(width) + " x " + std::to_string(height) +
-                   " is out of range");
-  const std::uint64_t row = std::uint64_t(width) * channels * depth;
-  if (step < row)
-    throw CdrError("step " + std::to_string(step) + " is shorter than a row (" +
-                   std::to_string(row) + " bytes)");
-  if (std::uint64_t(step) * height > pixels.size())
-    throw CdrError("data holds " + std::to_string(pixels.size()) + " bytes, step x height is " +
-                   std::to_string(std::uint64_t(step) * height));
-  const bool rgb = encoding[0] == 'r';
-  Image8 grey(static_cast<int>(width), static_cast<int>(height));
-  for (std::uint32_t y = 0; y < height; ++y) {
-    const auto* in = reinterpret_cast<const unsigned char*>(pixels.data()) + std::size_t(y) * step;
-    std::uint8_t* out = &grey.pixels[std::size_t(y) * width];
-    for (std::uint32_t x = 0; x < width; ++x) {
-      const unsigned char* p = in + std::size_t(x) * channels * depth;
-      if (depth == 2) {
-        const unsigned v = big_endian ? (p[0] << 8 | p[1]) : (p[1] << 8 | p[0]);
-        out[x] = static_cast<std::uint8_t>(v >> 8);
-      } else if (channels == 1) {
-        out[x] = p[0];
-      } else {
-        // ITU-R 601 luma, as OpenCV's colour conversion.
-        const double b = rgb ? p[2] : p[0], g = p[1], rr = rgb ? p[0] : p[2];
-        out[x] = static_cast<std::uint8_t>(std::lround(0.114 * b + 0.587 * g + 0.299 * rr));
-      }
-    }
-  }
-  f.image = std::move(grey);
+  raw.data = &pixels;
+  f.image = detail::grey_from_raw(raw);
   return f;
 }
 

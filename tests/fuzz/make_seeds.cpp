@@ -160,6 +160,18 @@ int main(int argc, char** argv) {
       .u32(10)
       .bytes(std::string(20, '\x40'));
   cdr(1, "raw_image", raw.data());
+  io::CdrWriter yuyv;  // packed YUV 4:2:2 from a webcam
+  yuyv.header(1'000, "cam").u32(3).u32(4).string("yuyv").u8(0).u32(8).bytes(std::string(24, 'y'));
+  cdr(1, "raw_image_yuyv", yuyv.data());
+  io::CdrWriter bayer;  // a 16-bit mosaic, big endian
+  bayer.header(1'000, "cam")
+      .u32(4)
+      .u32(4)
+      .string("bayer_grbg16")
+      .u8(1)
+      .u32(8)
+      .bytes(std::string(32, '\x21'));
+  cdr(1, "raw_image_bayer16", bayer.data());
   cdr(2, "odometry", io::ros2::odometry_message(t, "odom", "base_link", Pose2(1, -2, 0.3)));
   cdr(3, "joint_state",
       io::ros2::joint_state_message(t, {"left_wheel", "right_wheel"}, {1.5, -0.5}));

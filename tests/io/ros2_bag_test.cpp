@@ -291,7 +291,7 @@ TEST(Ros2Bag, DamagedMessagesAreSkippedNamingTheField) {
                               .header(1, "o")
                               .u32(4)
                               .u32(4)
-                              .string("yuv422")
+                              .string("32FC1")
                               .u8(0)
                               .u32(8)
                               .bytes(std::string(32, 'x'))
@@ -320,7 +320,7 @@ TEST(Ros2Bag, DamagedMessagesAreSkippedNamingTheField) {
   EXPECT_THAT(all, HasSubstr("neither PNG nor JPEG"));
   EXPECT_THAT(all, HasSubstr("encapsulation header"));
   EXPECT_THAT(all, HasSubstr("step 3 is shorter than a row"));
-  EXPECT_THAT(all, HasSubstr("encoding \"yuv422\" is not read"));
+  EXPECT_THAT(all, HasSubstr("encoding \"32FC1\" is not read"));
   EXPECT_THAT(all, HasSubstr("/odom message 0"));
   EXPECT_THAT(all, HasSubstr("sequence of 2147483647 elements"));
 }

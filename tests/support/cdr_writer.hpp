@@ -19,20 +19,26 @@ inline std::string compressed_image_cdr(std::int64_t stamp_ns, const std::string
   return CdrWriter(little).header(stamp_ns, frame).string(format).bytes(data).data();
 }
 
-// sensor_msgs/msg/Image in mono8, `height` rows of `step` bytes (a row's width and its padding),
-// as a camera driver publishes it.
-inline std::string mono8_image_cdr(std::int64_t stamp_ns, const std::string& frame,
-                                   std::uint32_t width, std::uint32_t height, std::uint32_t step,
-                                   const std::string& rows) {
+// sensor_msgs/msg/Image in `encoding`, `height` rows of `step` bytes (a row's pixels and its
+// padding), as a camera driver publishes it.
+inline std::string raw_image_cdr(std::int64_t stamp_ns, const std::string& frame,
+                                 const std::string& encoding, std::uint32_t width,
+                                 std::uint32_t height, std::uint32_t step,
+                                 const std::string& rows) {
   return CdrWriter()
       .header(stamp_ns, frame)
       .u32(height)
       .u32(width)
-      .string("mono8")
+      .string(encoding)
       .u8(0)
       .u32(step)
       .bytes(rows)
       .take();
+}
+inline std::string mono8_image_cdr(std::int64_t stamp_ns, const std::string& frame,
+                                   std::uint32_t width, std::uint32_t height, std::uint32_t step,
+                                   const std::string& rows) {
+  return raw_image_cdr(stamp_ns, frame, "mono8", width, height, step, rows);
 }
 
 // nav_msgs/msg/Odometry with a planar pose (x, y, yaw) and zero twist.

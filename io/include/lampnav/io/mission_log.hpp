@@ -244,10 +244,10 @@ struct MissionLog {
 };
 
 // Reads a mission log, or a ROS 2 bag in MCAP (schema encoding ros2msg, message encoding cdr):
-// sensor_msgs/msg/CompressedImage and Image (mono8, mono16, bgr8, rgb8, bgra8, rgba8; any step),
-// nav_msgs/msg/Odometry, sensor_msgs/msg/CameraInfo. Throws InputError for a file that is not
-// MCAP at all, and for a bag whose topics cannot be told apart (the message lists them); damaged
-// content is skipped, counted and reported in the result.
+// sensor_msgs/msg/CompressedImage and Image (mono, colour, packed YUV and Bayer encodings, 8 or 16
+// bits; any step: io/src/raw_pixels.hpp), nav_msgs/msg/Odometry, sensor_msgs/msg/CameraInfo. Throws
+// InputError for a file that is not MCAP at all, and for a bag whose topics cannot be told apart
+// (the message lists them); damaged content is skipped, counted and reported in the result.
 MissionLog read_mission_log(const std::string& path, const BagTopics& topics = {});
 // The same from the file's bytes (`source` names them in messages), and from a file read.
 MissionLog parse_mission_log(const std::string& bytes, const std::string& source,

@@ -29,8 +29,8 @@ namespace ros2 {
 // sensor_msgs/msg/CompressedImage: the bytes as they are (PNG or JPEG, told by their magic, not
 // by the free-text `format`).
 ImageFrame compressed_image(const std::string& cdr);
-// sensor_msgs/msg/Image (mono8, mono16, bgr8, rgb8, bgra8, rgba8; any step): grey, kept as a
-// fast PNG.
+// sensor_msgs/msg/Image (mono, colour, packed YUV and Bayer encodings, 8 or 16 bits; any step:
+// io/src/raw_pixels.hpp): grey, kept as a fast PNG.
 ImageFrame raw_image(const std::string& cdr);
 // The same as grey pixels, for a live node that has no use for the PNG.
 struct GreyImage {
