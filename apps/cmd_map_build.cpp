@@ -222,7 +222,11 @@ void add_map_survey_command(CLI::App& map, Job& run) {
   CLI::App* survey = map.add_subcommand(
       "survey", "Compare a drive with a map: failed, moved and new lamps, named by place");
   survey->add_option("MAP", args->map, "Map file (.geojson)")->required();
-  survey->add_option("LOG", args->log, "Mission log or ROS 2 bag of the drive (.mcap)")->required();
+  survey
+      ->add_option(
+          "LOG", args->log,
+          "Mission log (.mcap) or ROS 2 bag of the drive (its directory, or a .mcap or .db3 file)")
+      ->required();
   survey->add_option("--robot", args->robot, "robot.json (default: the log's attachment)");
   survey->add_flag("--json", args->json, "Print the findings as JSON");
   survey->add_option("--initial-pose", args->initial_pose,
@@ -240,7 +244,11 @@ void add_map_build_command(CLI::App& map, Job& run) {
   auto args = std::make_shared<BuildArgs>();
   CLI::App* build = map.add_subcommand(
       "build", "Build a map (lamps, places, connections) from a drive; never reads the log's map");
-  build->add_option("LOG", args->log, "Mission log or ROS 2 bag of the drive (.mcap)")->required();
+  build
+      ->add_option(
+          "LOG", args->log,
+          "Mission log (.mcap) or ROS 2 bag of the drive (its directory, or a .mcap or .db3 file)")
+      ->required();
   build->add_option("--robot", args->robot, "robot.json (default: the log's attachment)");
   build->add_option("-o,--output", args->out, "Map to write (.geojson)")->required();
   build->add_option("--names", args->names,

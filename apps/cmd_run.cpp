@@ -246,7 +246,9 @@ void add_run_commands(CLI::App& app, Job& run) {
       "replay",
       "Run the stack over a recorded mission; write replay.mcap, TUM trajectories, "
       "metrics.json and report.html");
-  pc->add_option("LOG", pa->log, "Mission log or ROS 2 bag (.mcap)")->required();
+  pc->add_option("LOG", pa->log,
+                 "Mission log (.mcap) or ROS 2 bag (its directory, or a .mcap or .db3 file)")
+      ->required();
   pc->add_option("--map", pa->map, "Map (.geojson); default the log's attachment");
   pc->add_option("--robot", pa->robot, "robot.json; default the log's attachment");
   pc->add_option("--initial-pose", pa->initial_pose,

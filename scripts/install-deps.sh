@@ -16,6 +16,8 @@ packages=(
   libyaml-cpp-dev
   # OpenCV's XML calibration files (io/), read by the XML parser ROS 2 itself uses
   libtinyxml2-dev
+  # ROS 2 bags in rosbag2's sqlite3 storage (.db3, the default up to Humble), read by SQLite
+  libsqlite3-dev
   # the ROS 2 wire (ros/, lampnav node): eProsima Fast DDS, ROS 2's default DDS
   libfastrtps-dev libfastcdr-dev
   # tests and benchmarks; Chromium opens the report headless in a test

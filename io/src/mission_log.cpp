@@ -2,6 +2,7 @@
 
 #include "foxglove_schemas.hpp"
 #include "ros2_bag.hpp"
+#include "rosbag2_storage.hpp"
 
 #include <algorithm>
 #include <array>
@@ -509,12 +510,16 @@ void keep(DecodedMessage& d, MissionLog& log) {
 }  // namespace
 
 MissionLog read_mission_log(const std::string& path, const BagTopics& bag_topics) {
-  return mission_log_of(read_mcap(path), path, bag_topics);
+  std::vector<std::string> notes;
+  const McapFile f = read_log_container(path, notes);
+  MissionLog log = mission_log_of(f, path, bag_topics);
+  log.notes.insert(log.notes.begin(), notes.begin(), notes.end());
+  return log;
 }
 
 MissionLog parse_mission_log(const std::string& bytes, const std::string& source,
                              const BagTopics& bag_topics) {
-  return mission_log_of(read_mcap_bytes(bytes, source), source, bag_topics);
+  return mission_log_of(read_log_bytes(bytes, source), source, bag_topics);
 }
 
 MissionLog mission_log_of(const McapFile& f, const std::string& path, const BagTopics& bag_topics) {

@@ -2,16 +2,20 @@
 // is recorded by `lampnav sim`; tests/interop/write_ros2_bag.mjs writes it again as a ROS 2 bag
 // with the official TypeScript MCAP writer (@mcap/core), Foxglove's ROS 2 CDR serializer
 // (@foxglove/rosmsg2-serialization) and ROS 2 Humble's message definitions
-// (@foxglove/rosmsg-msgs-common); `lampnav replay` of the bag gives the log's estimates.
+// (@foxglove/rosmsg-msgs-common); `lampnav replay` of the bag gives the log's estimates, and so
+// does the same bag moved into rosbag2's sqlite3 storage.
 
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 #include "cli_support.hpp"
+#include "lampnav/io/mcap.hpp"
 #include "lampnav_test.hpp"
+#include "rosbag2_writer.hpp"
 
 namespace lampnav {
 namespace {
@@ -70,7 +74,41 @@ TEST(BagInterop, ABagWrittenByRos2ToolingReplaysAsTheMission) {
   EXPECT_THAT(b.err, HasSubstr("ceiling camera images from /ceiling_camera/image/compressed"));
   EXPECT_THAT(b.err, HasSubstr("wheel odometry from /odom"));
   const auto ea = read_tum(dir + "/a/estimate.tum"), eb = read_tum(dir + "/b/estimate.tum");
+
+  // The same bag in rosbag2's sqlite3 storage (ROS 2's default up to Humble), as `ros2 bag
+  // record --max-bag-size` splits it, its second file compressed message by message: read
+  // through its directory, it replays to the same estimates.
+  const std::string db3 = dir + "/corridor_db3";
+  fs::create_directories(db3);
+  {
+    const io::McapFile f = io::read_mcap(bag);
+    const std::size_t half = f.messages.size() / 2;
+    for (int part = 0; part < 2; ++part) {
+      test::Rosbag2SqliteWriter w(db3 + "/corridor_db3_" + std::to_string(part) + ".db3");
+      std::map<std::uint16_t, std::int64_t> topic_of;
+      for (const auto& ch : f.channels)
+        topic_of[ch.id] = w.topic(ch.topic, f.schema(ch.schema_id)->name, ch.message_encoding);
+      for (std::size_t k = part == 0 ? 0 : half; k < (part == 0 ? half : f.messages.size()); ++k)
+        w.write(topic_of[f.messages[k].channel_id],
+                static_cast<std::int64_t>(f.messages[k].log_time), f.messages[k].data, part == 1);
+    }
+    std::ofstream(db3 + "/metadata.yaml")
+        << "rosbag2_bagfile_information:\n  version: 9\n  storage_identifier: sqlite3\n"
+           "  relative_file_paths:\n    - corridor_db3_0.db3\n    - corridor_db3_1.db3\n"
+           "  compression_format: zstd\n  compression_mode: MESSAGE\n";
+  }
+  const test::CliResult c = test::run_lampnav("replay '" + db3 + "' --map " + map + " --robot " +
+                                              robot + " -q --out '" + dir + "/c'");
+  ASSERT_EQ(c.status, 0) << c.err;
+  EXPECT_THAT(c.err, HasSubstr("rosbag2 bag (sqlite3 storage), 2 files"));
+  const auto ec = read_tum(dir + "/c/estimate.tum");
   fs::remove_all(dir);
+  ASSERT_EQ(ec.size(), eb.size());
+  for (std::size_t k = 0; k < eb.size(); ++k) {
+    ASSERT_EQ(ec[k].t, eb[k].t) << k;
+    ASSERT_EQ(ec[k].x, eb[k].x) << k;
+    ASSERT_EQ(ec[k].y, eb[k].y) << k;
+  }
   ASSERT_GT(ea.size(), 1000u);
   ASSERT_EQ(ea.size(), eb.size());
   double worst = 0;

@@ -1,7 +1,8 @@
 // Writes the fuzzers' seed corpora that are not copies of files in the tree (tests/fuzz/corpus/):
 // small mission logs in each container form (zstd chunks, uncompressed, unchunked, no summary,
-// cut short), a ROS 2 bag, one CDR message of each type the node and the bag reader take, tiny
-// images, route commands, calibrations and robots. Run once when a reader changes:
+// cut short), a ROS 2 bag in MCAP and in rosbag2's SQLite, one CDR message of each type the node
+// and the bag reader take, tiny images, route commands, calibrations and robots. Run once when a
+// reader changes:
 //   build/tests/fuzz/lampnav_make_seeds tests/fuzz/corpus
 // The bundled maps and fixtures are copied beside them by the same program.
 
@@ -10,12 +11,14 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <map>
 
 #include "cdr.hpp"  // io's CDR writer, for messages the library has no encoder of
 #include "lampnav/core/robot_description.hpp"
 #include "lampnav/io/mcap.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/io/ros2_messages.hpp"
+#include "rosbag2_writer.hpp"  // tests/support
 
 using namespace lampnav;
 namespace fs = std::filesystem;
@@ -98,6 +101,25 @@ std::string bag_bytes() {
   return b;
 }
 
+// The same bag in rosbag2's sqlite3 storage, its images compressed message by message.
+std::string db3_bytes() {
+  const io::McapFile bag = io::read_mcap_bytes(bag_bytes(), "bag");
+  const fs::path tmp = fs::temp_directory_path() / "lampnav_seed_bag.db3";
+  fs::remove(tmp);
+  {
+    test::Rosbag2SqliteWriter w(tmp.string());
+    std::map<std::uint16_t, std::int64_t> topic_of;
+    for (const auto& ch : bag.channels)
+      topic_of[ch.id] = w.topic(ch.topic, bag.schema(ch.schema_id)->name);
+    for (const auto& m : bag.messages)
+      w.write(topic_of[m.channel_id], static_cast<std::int64_t>(m.log_time), m.data,
+              bag.channel(m.channel_id)->topic.find("image") != std::string::npos);
+  }
+  std::string b = slurp(tmp);
+  fs::remove(tmp);
+  return b;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -143,6 +165,9 @@ int main(int argc, char** argv) {
     put(h, "log_cut.mcap", log.substr(0, log.size() * 2 / 3));
     put(h, "bag.mcap", bag_bytes());
   }
+  // ROS 2 bags in rosbag2's sqlite3 storage: one made here, and one rosbag2 itself wrote.
+  put("mission_log", "bag.db3", db3_bytes());
+  put("mission_log", "talker.db3", slurp(src / "tests/fixtures/rosbag2/talker/talker.db3"));
 
   // CDR messages: the first byte picks the decoder (harnesses.cpp).
   const Stamp t = ms(1500);
