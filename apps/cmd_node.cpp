@@ -247,6 +247,92 @@ void check_cameras(ros::RosRobot& ros_robot, const NodeArgs& a, const RobotDescr
   }
 }
 
+// The node's health on /diagnostics, once a second, as ROS's diagnostic tools show it:
+// - localization: OK while one pose is known (tracking, relocalized); WARN while it is one of
+//   several places (ambiguous) or looked for (lost), saying which;
+// - each input (the cameras in use, the odometry): OK with its rate; WARN when messages of it
+//   were dropped (the node slower than the camera) or refused since the last report; ERROR when
+//   none has come for 2 s or more, or none yet.
+class HealthReport {
+ public:
+  explicit HealthReport(const ros::NodeTopics& topics) : topics_(topics) {}
+
+  std::vector<io::ros2::DiagnosticStatus> report(const ros::NodeCounts& now,
+                                                 ros::Clock::time_point at) {
+    using Status = io::ros2::DiagnosticStatus;
+    std::vector<Status> out;
+    Status where;
+    where.name = "lampnav: localization";
+    where.values = {{"mode", now.mode.empty() ? "none yet" : now.mode},
+                    {"hypotheses", std::to_string(now.hypotheses)},
+                    {"poses_published", std::to_string(now.poses_published)}};
+    if (now.mode == "tracking" || now.mode == "relocalized") {
+      where.message = now.mode;
+    } else {
+      where.level = Status::warn;
+      where.message =
+          now.mode == "ambiguous" ? "ambiguous: one of " + std::to_string(now.hypotheses) +
+                                        " places (the pose is not published; see the hypotheses)"
+          : now.mode == "lost" ? "lost: looking for the robot (the pose is not published)"
+                               : "no estimate yet";
+    }
+    out.push_back(where);
+    const double dt = seen_ ? std::chrono::duration<double>(at - last_at_).count() : 0;
+    auto input = [&](int k, const char* name, const std::string& topic, const ros::InputCounts& c,
+                     const ros::InputCounts& before) {
+      if (topic.empty()) return;
+      Status s;
+      s.name = std::string("lampnav: ") + name;
+      s.hardware_id = topic;
+      if (c.received > before.received) last_message_[k] = at;  // (the first report: since start)
+      const double rate = dt > 0 ? static_cast<double>(c.received - before.received) / dt : 0;
+      char buf[64];
+      std::snprintf(buf, sizeof buf, "%.1f", rate);
+      s.values = {{"received", std::to_string(c.received)},
+                  {"used", std::to_string(c.used)},
+                  {"dropped", std::to_string(c.dropped)},
+                  {"refused", std::to_string(c.refused)},
+                  {"rate_hz", buf}};
+      const std::uint64_t dropped = c.dropped - before.dropped,
+                          refused = c.refused - before.refused;
+      const double silent =
+          last_message_[k] ? std::chrono::duration<double>(at - *last_message_[k]).count() : 0;
+      if (c.received == 0) {
+        s.level = Status::error;
+        s.message = "nothing yet on " + topic;
+      } else if (silent >= 2) {
+        std::snprintf(buf, sizeof buf, "%.1f", silent);
+        s.level = Status::error;
+        s.message = std::string("nothing for ") + buf + " s on " + topic;
+      } else if (dropped + refused > 0) {
+        s.level = Status::warn;
+        s.message = std::to_string(dropped) + " dropped (the node is slower than the input), " +
+                    std::to_string(refused) +
+                    " refused (the node's log says why) since the last report";
+      } else {
+        std::snprintf(buf, sizeof buf, "%.1f Hz", rate);
+        s.message = buf;
+      }
+      out.push_back(s);
+    };
+    input(0, "ceiling camera", topics_.ceiling_image, now.ceiling, last_.ceiling);
+    input(1, "omni camera", topics_.omni_image, now.omni, last_.omni);
+    input(2, "odometry", topics_.joint_states.empty() ? topics_.odometry : topics_.joint_states,
+          now.odometry, last_.odometry);
+    last_ = now;
+    last_at_ = at;
+    seen_ = true;
+    return out;
+  }
+
+ private:
+  ros::NodeTopics topics_;
+  ros::NodeCounts last_;
+  ros::Clock::time_point last_at_{};
+  std::optional<ros::Clock::time_point> last_message_[3];
+  bool seen_ = false;
+};
+
 int run_node(NodeArgs& a) {
   // Images of up to a megabyte come and go at 30 Hz. By default glibc maps each such block from
   // the kernel and gives it back when freed, so every frame's pixels are faulted in again page by
@@ -284,6 +370,7 @@ int run_node(NodeArgs& a) {
     ros::NodeCounts reported;
     bool counting = false;  // images dropped while the node waited for the mounts are not news
     CameraChecks checks;
+    HealthReport health(ro.topics);
     for (int tick = 1; !done; ++tick) {
       if (g_stop) ros_robot.stop();
       if (!counting && looping) {
@@ -292,7 +379,10 @@ int run_node(NodeArgs& a) {
         tick = 1;
       }
       // Every second; `robot` is the node's own from the start on.
-      if (counting && tick % 20 == 0) check_cameras(ros_robot, a, robot, checks);
+      if (counting && tick % 20 == 0) {
+        check_cameras(ros_robot, a, robot, checks);
+        ros_robot.publish_diagnostics(health.report(ros_robot.counts(), ros::Clock::now()));
+      }
       if (counting && !a.quiet && tick % 100 == 0) {  // every 5 s: images dropped since then
         const ros::NodeCounts c = ros_robot.counts();
         const std::uint64_t ceiling = c.ceiling.dropped - reported.ceiling.dropped,
@@ -441,6 +531,10 @@ void add_node_command(CLI::App& app, Job& run) {
   c->add_option("--command-topic", t.command, "std_msgs/msg/String route commands")
       ->capture_default_str();
   c->add_option("--cmd-vel-topic", t.cmd_vel, "geometry_msgs/msg/Twist out")->capture_default_str();
+  c->add_option("--diagnostics-topic", t.diagnostics,
+                "diagnostic_msgs/msg/DiagnosticArray out, every second: localization and inputs "
+                "(\"\": none)")
+      ->capture_default_str();
   c->add_option("--namespace", t.ns, "the node's outputs: pose, mode, hypotheses, events")
       ->capture_default_str();
   c->add_flag("--no-ceiling", a->no_ceiling, "do not use the ceiling camera");

@@ -295,6 +295,18 @@ std::string twist(double forward, double turn) {
 
 std::string string_message(const std::string& text) { return CdrWriter().string(text).take(); }
 
+std::string diagnostic_array(Stamp stamp, const std::vector<DiagnosticStatus>& statuses) {
+  CdrWriter w;
+  w.header(ns(stamp), "");
+  w.u32(static_cast<std::uint32_t>(statuses.size()));
+  for (const auto& s : statuses) {
+    w.u8(s.level).string(s.name).string(s.message).string(s.hardware_id);
+    w.u32(static_cast<std::uint32_t>(s.values.size()));
+    for (const auto& [key, value] : s.values) w.string(key).string(value);
+  }
+  return w.take();
+}
+
 std::string compressed_image_message(Stamp stamp, const std::string& frame,
                                      const std::string& format, const std::string& data) {
   return CdrWriter().header(ns(stamp), frame).string(format).bytes(data).take();

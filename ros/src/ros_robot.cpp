@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <condition_variable>
 #include <future>
@@ -188,6 +189,8 @@ RosRobot::RosRobot(Participant& p, const RosRobotOptions& options)
   mode_ = &p.writer(t.ns + "/mode", "std_msgs/msg/String", Qos::state);
   hypotheses_ = &p.writer(t.ns + "/hypotheses", "geometry_msgs/msg/PoseArray", Qos::state);
   events_ = &p.writer(t.ns + "/events", "std_msgs/msg/String", Qos::state);
+  if (!t.diagnostics.empty())
+    diagnostics_ = &p.writer(t.diagnostics, "diagnostic_msgs/msg/DiagnosticArray", Qos::state);
   inbox_ = std::make_shared<detail::Inbox>();
   inbox_->holding = o_.hold_images;
   if (!t.ceiling_image.empty()) inbox_->ceiling_decoder = decoding_thread(o_.ceiling_size);
@@ -542,6 +545,8 @@ void RosRobot::publish(const fusion::LocalizerEstimate& e) {
   if (!last_mode_ || *last_mode_ != e.mode) {
     mode_->write(io::ros2::string_message(fusion::to_string(e.mode)));
     last_mode_ = e.mode;
+    std::lock_guard<std::mutex> lock(inbox_->mutex);
+    inbox_->counts.mode = fusion::to_string(e.mode);
   }
   const double leader = e.hypotheses.empty() ? -1 : e.hypotheses.front().weight;
   if (e.hypotheses.size() != last_hypotheses_ || leader != last_leader_weight_) {
@@ -550,7 +555,17 @@ void RosRobot::publish(const fusion::LocalizerEstimate& e) {
     hypotheses_->write(io::ros2::pose_array(e.stamp, f.map, poses));
     last_hypotheses_ = e.hypotheses.size();
     last_leader_weight_ = leader;
+    std::lock_guard<std::mutex> lock(inbox_->mutex);
+    inbox_->counts.hypotheses = e.hypotheses.size();
   }
+}
+
+void RosRobot::publish_diagnostics(const std::vector<io::ros2::DiagnosticStatus>& statuses) {
+  if (!diagnostics_) return;
+  const auto now = std::chrono::system_clock::now().time_since_epoch();
+  diagnostics_->write(io::ros2::diagnostic_array(
+      stamp_from_nanoseconds(std::chrono::duration_cast<std::chrono::nanoseconds>(now).count()),
+      statuses));
 }
 
 void RosRobot::publish_event(const std::string& text) {

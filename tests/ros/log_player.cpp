@@ -5,6 +5,7 @@
 // writes what the node publishes on /lampnav/pose. For the node's tests and benchmark.
 //
 //   lampnav_log_player LOG.mcap --domain D [--rate R] [--wheel-radius M] [--poses OUT]
+//                      [--diagnostics OUT]
 //                      [--wait-s S] [--loops N] [--jpeg QUALITY | --raw]
 //                      [--pose-estimate X,Y,YAW]   (sent on /initialpose after the first wheels)
 //                      [--tf-static]   (the log's camera mounts on /tf_static, transient local)
@@ -126,6 +127,14 @@ int main(int argc, char** argv) {
                 last_pose_ns = s.arrival.time_since_epoch().count();
               });
 
+  std::vector<std::string> diagnostics;
+  if (!o.diagnostics.empty())
+    p.subscribe("/diagnostics", "diagnostic_msgs/msg/DiagnosticArray", ros::Qos::state,
+                [&](ros::Sample&& s) {
+                  std::lock_guard<std::mutex> lock(m);
+                  diagnostics.push_back(std::move(s.cdr));
+                });
+
   // The node must be there before anything is played (its omni reader too, unless the node is
   // to be told where the robot is: then it may run without the omni camera).
   const auto deadline = Clock::now() + std::chrono::duration<double>(o.wait_s);
@@ -192,6 +201,11 @@ int main(int argc, char** argv) {
     std::ofstream out(o.poses);
     std::lock_guard<std::mutex> lock(m);
     for (const auto& cdr : poses) out << test::pose_line(cdr) << "\n";
+  }
+  if (!o.diagnostics.empty()) {
+    std::ofstream out(o.diagnostics);
+    std::lock_guard<std::mutex> lock(m);
+    for (const auto& cdr : diagnostics) out << test::diagnostic_lines(cdr);
   }
   std::cout << "sent " << sent[0] << " joint states, " << sent[1] << " ceiling and " << sent[2]
             << " omni images in " << played_s << " s (" << refused << " refused); received "

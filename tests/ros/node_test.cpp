@@ -122,14 +122,61 @@ void expect_published_as_replayed(const std::map<std::int64_t, Pose2>& node,
   EXPECT_LE(a.worst, 1e-3);
 }
 
+// The node's /diagnostics as the player heard them while it played (diagnostic_lines): every
+// second the localization and each input; while played, the cameras and the wheels OK at their
+// rates, the localization OK once tracking. An input that is ERROR says it is silent (the node
+// reports before the player starts and after it stops too).
+void expect_healthy_while_played(const std::string& lines) {
+  std::istringstream in(lines);
+  std::string line;
+  std::map<std::string, int> ok;
+  int reports = 0;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::istringstream fields(line);
+    for (std::string x; std::getline(fields, x, '|');) f.push_back(x);
+    ASSERT_GE(f.size(), 4u) << line;
+    const std::string &level = f[0], name = f[1], message = f[2];
+    ASSERT_TRUE(level == "0" || level == "1" || level == "2") << line;
+    if (name == "lampnav: localization") {
+      ++reports;
+      if (level == "0") {
+        EXPECT_TRUE(message == "tracking" || message == "relocalized") << line;
+      }
+      if (level == "1") {
+        EXPECT_FALSE(message.empty()) << line;
+      }
+      EXPECT_NE(level, "2") << line;
+    } else {
+      ASSERT_TRUE(name == "lampnav: ceiling camera" || name == "lampnav: omni camera" ||
+                  name == "lampnav: odometry")
+          << line;
+      if (level == "2") {
+        EXPECT_EQ(message.rfind("nothing", 0), 0u) << line;
+      }
+      if (level == "0") {
+        EXPECT_THAT(message, ::testing::EndsWith(" Hz")) << line;
+      }
+    }
+    if (level == "0") ++ok[name];
+  }
+  std::cout << reports << " diagnostics reports\n";
+  EXPECT_GE(reports, 10);
+  for (const char* name : {"lampnav: localization", "lampnav: ceiling camera",
+                           "lampnav: omni camera", "lampnav: odometry"})
+    EXPECT_GE(ok[name], 5) << name;
+}
+
 TEST(Node, PublishesThePosesReplayComputesFromTheSameLog) {
   const CorridorRun run("node_test");
   const evaluation::ReplayResult replayed = evaluation::replay(run.log, run.map, run.robot);
   run.start_node("");
   // The ceiling camera's driver publishes a calibration 1 % longer in focal length than
   // robot.json's: the node says so, and goes on with robot.json's.
-  const nlohmann::json stats = run.play("--rate 2 --camera-info 1.01");
+  const nlohmann::json stats =
+      run.play("--rate 2 --camera-info 1.01 --diagnostics '" + run.dir + "/diagnostics.txt'");
   ASSERT_FALSE(stats.is_null());
+  expect_healthy_while_played(test::slurp(run.dir + "/diagnostics.txt"));
   EXPECT_GT(stats["camera_info"]["used"], 0u);
   EXPECT_THAT(test::slurp(run.dir + "/node.out"),
               ::testing::HasSubstr("warning: /ceiling_camera/camera_info: its calibration "

@@ -1,5 +1,5 @@
 #pragma once
-// The log player's command line, and the poses it hears back as text lines.
+// The log player's command line, and the poses and diagnostics it hears back as text lines.
 
 #include <cmath>
 #include <cstdio>
@@ -14,6 +14,7 @@ namespace lampnav::test {
 
 struct PlayerOptions {
   std::string log, poses;
+  std::string diagnostics;  // where to write the node's /diagnostics as heard, one status a line
   int domain = 0, loops = 1;
   int jpeg_quality = 0;  // > 0: images sent as JPEG of this quality (decoded and encoded first)
   bool raw = false;      // images sent as sensor_msgs/msg/Image (mono8), decoded first
@@ -70,6 +71,8 @@ inline PlayerOptions parse_player_options(int argc, char** argv) {
       o.pose_estimate = Pose2(x, y, yaw);
     } else if (a == "--poses" && k + 1 < argc)
       o.poses = argv[++k];
+    else if (a == "--diagnostics" && k + 1 < argc)
+      o.diagnostics = argv[++k];
     else if (!a.empty() && a[0] != '-' && o.log.empty())
       o.log = a;
     else
@@ -81,6 +84,28 @@ inline PlayerOptions parse_player_options(int argc, char** argv) {
   if (!(o.rate > 0) || !(o.wheel_radius > 0) || o.loops < 1)
     throw std::invalid_argument("--rate, --wheel-radius and --loops must be positive");
   return o;
+}
+
+// diagnostic_msgs/msg/DiagnosticArray as lines "level|name|message|hardware_id|key=value,...".
+inline std::string diagnostic_lines(const std::string& cdr) {
+  io::CdrReader r(cdr);
+  r.i32("sec");
+  r.u32("nanosec");
+  r.string("frame_id");
+  std::string out;
+  const std::uint32_t n = r.u32("status");
+  for (std::uint32_t k = 0; k < n; ++k) {
+    out += std::to_string(r.u8("level"));
+    for (const char* f : {"name", "message", "hardware_id"}) out += "|" + r.string(f);
+    out += "|";
+    const std::uint32_t values = r.u32("values");
+    for (std::uint32_t v = 0; v < values; ++v) {
+      out += (v ? "," : "") + r.string("key");
+      out += "=" + r.string("value");
+    }
+    out += "\n";
+  }
+  return out;
 }
 
 // geometry_msgs/msg/PoseWithCovarianceStamped as "stamp_ns x y yaw".

@@ -157,6 +157,31 @@ TEST(RosWire, EveryMessageIsByteForByteWhatRos2ToolingWrites) {
        {"effort", Json::array()}},
       io::ros2::joint_state_message(t, {"left_wheel_joint", "right_wheel_joint"}, {12.25, -3.5}));
 
+  io::ros2::DiagnosticStatus camera;
+  camera.level = io::ros2::DiagnosticStatus::error;
+  camera.name = "lampnav: omni camera";
+  camera.message = "no image for 3.0 s";
+  camera.hardware_id = "/omni_camera/image_raw/compressed";
+  camera.values = {{"received", "120"}, {"rate_hz", "0.0"}};
+  io::ros2::DiagnosticStatus localization;
+  localization.name = "lampnav: localization";
+  localization.message = "tracking";
+  add("diagnostic_msgs/msg/DiagnosticArray",
+      {{"header", header(t, "")},
+       {"status",
+        {{{"level", 2},
+          {"name", camera.name},
+          {"message", camera.message},
+          {"hardware_id", camera.hardware_id},
+          {"values",
+           {{{"key", "received"}, {"value", "120"}}, {{"key", "rate_hz"}, {"value", "0.0"}}}}},
+         {{"level", 0},
+          {"name", localization.name},
+          {"message", "tracking"},
+          {"hardware_id", ""},
+          {"values", Json::array()}}}}},
+      io::ros2::diagnostic_array(t, {camera, localization}));
+
   const std::string file = test::temp_path("ros2_messages.json");
   std::ofstream(file) << cases.dump();
   int status = -1;

@@ -7,9 +7,11 @@
 // refused before anything is allocated.
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "lampnav/core/pose2.hpp"
@@ -92,6 +94,15 @@ std::string tf_message(const std::vector<FrameTransform>& transforms);
 std::string twist(double forward, double turn);
 // std_msgs/msg/String.
 std::string string_message(const std::string& text);
+// diagnostic_msgs/msg/DiagnosticStatus and DiagnosticArray: a part's health as ROS's diagnostic
+// tools show it (rqt_robot_monitor, Foxglove's diagnostics panels).
+struct DiagnosticStatus {
+  enum Level : std::uint8_t { ok = 0, warn = 1, error = 2, stale = 3 };
+  Level level = ok;
+  std::string name, message, hardware_id;
+  std::vector<std::pair<std::string, std::string>> values;  // key, value
+};
+std::string diagnostic_array(Stamp stamp, const std::vector<DiagnosticStatus>& statuses);
 // What a robot's drivers publish (the test players and bag writers use them).
 std::string compressed_image_message(Stamp stamp, const std::string& frame,
                                      const std::string& format, const std::string& data);

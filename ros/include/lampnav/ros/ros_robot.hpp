@@ -45,6 +45,8 @@ struct NodeTopics {
   // the robot's URDF). Empty: not subscribed.
   std::string tf_static = "/tf_static";
   std::string cmd_vel = "/cmd_vel";  // geometry_msgs/msg/Twist
+  // diagnostic_msgs/msg/DiagnosticArray, where ROS's diagnostic tools look. Empty: none.
+  std::string diagnostics = "/diagnostics";
   // Outputs under this namespace: pose, mode, hypotheses, events (and /tf).
   std::string ns = "/lampnav";
 };
@@ -92,6 +94,9 @@ struct InputCounts {
 struct NodeCounts {
   InputCounts ceiling, omni, odometry, commands, pose_estimates, static_transforms, camera_info;
   std::uint64_t poses_published = 0;
+  // What was published last: the mode ("" before any estimate) and how many hypotheses.
+  std::string mode;
+  std::size_t hypotheses = 0;
 };
 
 class RosRobot : public Robot {
@@ -111,6 +116,9 @@ class RosRobot : public Robot {
   void publish(const fusion::LocalizerEstimate& estimate);
   // A line on <ns>/events (commands taken or refused, the mission's end).
   void publish_event(const std::string& text);
+  // The node's parts' health on the diagnostics topic, stamped with this machine's clock (from
+  // any one thread; nothing when the topic is empty).
+  void publish_diagnostics(const std::vector<io::ros2::DiagnosticStatus>& statuses);
 
   // When the input next() last returned arrived (for latency), and when it was ready (decoded):
   // from arrival to ready is decoding and queueing, from ready on the stack's processing.
@@ -144,7 +152,7 @@ class RosRobot : public Robot {
   void close();
 
   RosRobotOptions o_;
-  Writer *cmd_vel_, *pose_, *tf_, *mode_, *hypotheses_, *events_;
+  Writer *cmd_vel_, *pose_, *tf_, *mode_, *hypotheses_, *events_, *diagnostics_ = nullptr;
   // What the DDS threads hand over (the queue, the counts, each camera's decoding thread), shared
   // with the participant's callbacks: the participant may call them after the robot is gone (it
   // outlives the robot), and they then find the inbox closed and drop the message.
