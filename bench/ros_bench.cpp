@@ -6,7 +6,8 @@
 // received. The iteration time is the ceiling camera's p99; the rest are counters. Run twice:
 // the images as PNG (a 1024 x 1024 omni frame takes 11 ms to decode alone), as most camera
 // drivers compress them (JPEG, quality 90; argument 90), and as raw grey frames
-// (sensor_msgs/msg/Image, mono8, on .../image_raw; argument -1). Second argument 1: the node is
+// (sensor_msgs/msg/Image, mono8, on .../image_raw; argument -1; -2: yuyv, a webcam's own
+// format). Second argument 1: the node is
 // told where the robot starts (--initial-pose), as a robot's launch file or /initialpose would;
 // 0: it finds the start from the omni camera, enumerating the places its first images fit.
 // Images after which no pose went out (the start not found yet) are timed apart, to the
@@ -75,9 +76,10 @@ void BM_NodeImageToPose(benchmark::State& state) {
                              dir + "/stats.json > " + dir + "/node.out 2>&1 &";
     const std::string player = std::string(LAMPNAV_LOG_PLAYER) + " " + log + " --domain " + domain +
                                " --rate 3.05 --wheel-radius 0.1 --tf-static" +
-                               (state.range(0) > 0   ? " --jpeg " + std::to_string(state.range(0))
-                                : state.range(0) < 0 ? std::string(" --raw")
-                                                     : std::string()) +
+                               (state.range(0) > 0     ? " --jpeg " + std::to_string(state.range(0))
+                                : state.range(0) == -2 ? std::string(" --raw-encoding yuyv")
+                                : state.range(0) < 0   ? std::string(" --raw")
+                                                       : std::string()) +
                                " > " + dir + "/player.out 2>&1";
     if (std::system(node.c_str()) != 0 || std::system(player.c_str()) != 0) {
       state.SkipWithError(("the node or the player failed: " + slurp(dir + "/player.out")).c_str());
@@ -122,6 +124,7 @@ BENCHMARK(BM_NodeImageToPose)
     ->Args({90, 1})
     ->Args({-1, 0})
     ->Args({-1, 1})
+    ->Args({-2, 1})
     ->Iterations(1)
     ->UseManualTime()
     ->Unit(benchmark::kMillisecond);

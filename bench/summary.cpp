@@ -386,7 +386,8 @@ int main(int argc, char** argv) {
                                     {"90/0", "JPEG 90"},
                                     {"90/1", "JPEG 90, start pose given"},
                                     {"-1/0", "raw mono8"},
-                                    {"-1/1", "raw mono8, start pose given"}}) {
+                                    {"-1/1", "raw mono8, start pose given"},
+                                    {"-2/1", "raw yuyv, start pose given"}}) {
     const std::string bench = std::string("BM_NodeImageToPose/") + arg;
     for (const char* camera : {"ceiling", "omni"})
       for (const char* q : {"p50", "p99"})

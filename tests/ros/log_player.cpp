@@ -1,12 +1,13 @@
 // lampnav_log_player: plays a recorded mission over DDS as a ROS 2 robot's drivers would (the
 // wheel joints as sensor_msgs/msg/JointState, the cameras as sensor_msgs/msg/CompressedImage
-// (or, with --raw, as sensor_msgs/msg/Image in mono8 on .../image_raw),
+// (or, with --raw, as sensor_msgs/msg/Image in mono8 on .../image_raw; --raw-encoding bgr8,
+// yuyv or bayer_rggb8 for those),
 // header stamps the capture times), at the pace of the log's arrival times (times --rate), and
 // writes what the node publishes on /lampnav/pose. For the node's tests and benchmark.
 //
 //   lampnav_log_player LOG.mcap --domain D [--rate R] [--wheel-radius M] [--poses OUT]
 //                      [--diagnostics OUT]
-//                      [--wait-s S] [--loops N] [--jpeg QUALITY | --raw]
+//                      [--wait-s S] [--loops N] [--jpeg QUALITY | --raw | --raw-encoding E]
 //                      [--pose-estimate X,Y,YAW]   (sent on /initialpose after the first wheels)
 //                      [--tf-static]   (the log's camera mounts on /tf_static, transient local)
 //                      [--camera-info SCALE]   (the ceiling camera's CameraInfo, focal x SCALE)
@@ -102,18 +103,30 @@ int main(int argc, char** argv) {
     p.writer("/tf_static", "tf2_msgs/msg/TFMessage", ros::Qos::tf_static)
         .write(io::ros2::tf_message(mounts));
   }
-  // Raw frames are decoded before playing, as a camera driver hands them over.
-  std::vector<Image8> raw_ceiling, raw_omni;
+  // Raw frames are decoded and laid out in their encoding before playing, as a camera driver
+  // hands them over.
+  const int bytes = o.raw_encoding == "bgr8" ? 3 : o.raw_encoding == "yuyv" ? 2 : 1;
+  struct Raw {
+    std::uint32_t width, height;
+    std::string rows;
+  };
+  auto raw = [&](const io::ImageFrame& f) {
+    const Image8 g = io::decode_image(f.data, o.log);
+    Raw r{static_cast<std::uint32_t>(g.width), static_cast<std::uint32_t>(g.height),
+          std::string(g.pixels.size() * bytes, '\0')};
+    for (std::size_t k = 0; k < g.pixels.size(); ++k)
+      for (int c = 0; c < bytes; ++c)  // yuyv: Y, then U or V, neutral
+        r.rows[k * bytes + c] = bytes == 2 && c == 1 ? '\x80' : static_cast<char>(g.pixels[k]);
+    return r;
+  };
+  std::vector<Raw> raw_ceiling, raw_omni;
   if (o.raw) {
-    for (const auto& f : log.ceiling_images)
-      raw_ceiling.push_back(io::decode_image(f.value.data, o.log));
-    for (const auto& f : log.omni_images) raw_omni.push_back(io::decode_image(f.value.data, o.log));
+    for (const auto& f : log.ceiling_images) raw_ceiling.push_back(raw(f.value));
+    for (const auto& f : log.omni_images) raw_omni.push_back(raw(f.value));
   }
-  const auto image_message = [](Stamp stamp, const char* frame, const Image8& image) {
-    const auto width = static_cast<std::uint32_t>(image.width);
-    return test::mono8_image_cdr(to_nanoseconds(stamp), frame, width,
-                                 static_cast<std::uint32_t>(image.height), width,
-                                 std::string(image.pixels.begin(), image.pixels.end()));
+  const auto image_message = [&](Stamp stamp, const char* frame, const Raw& image) {
+    return test::raw_image_cdr(to_nanoseconds(stamp), frame, o.raw_encoding, image.width,
+                               image.height, image.width * bytes, image.rows);
   };
   std::mutex m;
   std::vector<std::string> poses;

@@ -17,7 +17,9 @@ struct PlayerOptions {
   std::string diagnostics;  // where to write the node's /diagnostics as heard, one status a line
   int domain = 0, loops = 1;
   int jpeg_quality = 0;  // > 0: images sent as JPEG of this quality (decoded and encoded first)
-  bool raw = false;      // images sent as sensor_msgs/msg/Image (mono8), decoded first
+  bool raw = false;      // images sent as sensor_msgs/msg/Image, decoded first
+  // Their encoding: mono8, bgr8, yuyv (chroma neutral) or bayer_rggb8 (each site the grey).
+  std::string raw_encoding = "mono8";
   // The cameras' mounts of the log's robot.json sent on /tf_static (base_footprint -> each
   // camera's frame), once, before any node is there (transient local, as robot_state_publisher).
   bool tf_static = false;
@@ -59,7 +61,13 @@ inline PlayerOptions parse_player_options(int argc, char** argv) {
       o.jpeg_quality = static_cast<int>(number(k));
     else if (a == "--raw")
       o.raw = true;
-    else if (a == "--tf-static")
+    else if (a == "--raw-encoding" && k + 1 < argc) {
+      o.raw = true;
+      o.raw_encoding = argv[++k];
+      if (o.raw_encoding != "mono8" && o.raw_encoding != "bgr8" && o.raw_encoding != "yuyv" &&
+          o.raw_encoding != "bayer_rggb8")
+        throw std::invalid_argument("--raw-encoding: mono8, bgr8, yuyv or bayer_rggb8");
+    } else if (a == "--tf-static")
       o.tf_static = true;
     else if (a == "--camera-info")
       o.camera_info_scale = number(k);
