@@ -9,6 +9,7 @@
 
 #include <visp3/blob/vpDot2.h>
 #include <visp3/core/vpImage.h>
+#include <array>
 #include <map>
 #include <opencv2/features2d.hpp>
 #include <random>
@@ -272,29 +273,19 @@ BENCHMARK(BM_DecodeOmniFrame)->Arg(0)->Arg(90)->Unit(benchmark::kMicrosecond);
 // webcam's yuyv and a Bayer mosaic (rggb8), each pixel the frame's grey level.
 void BM_ReadRawOmniFrame(benchmark::State& state) {
   const OmniFrames& f = omni_frames();
-  struct Encoding {
-    const char* name;
-    int bytes;  // a pixel
-  };
-  constexpr Encoding kEncodings[] = {{"mono8", 1}, {"bgr8", 3}, {"yuyv", 2}, {"bayer_rggb8", 1}};
-  const Encoding& e = kEncodings[state.range(0)];
+  const char* encoding = std::array{"mono8", "bgr8", "yuyv", "bayer_rggb8"}[state.range(0)];
+  const int bytes = test::raw_bytes_per_pixel(encoding);
   std::vector<std::string> messages;
-  for (const Image8& image : f.images) {
-    std::string rows(image.pixels.size() * e.bytes, '\0');
-    for (std::size_t k = 0; k < image.pixels.size(); ++k) {
-      const char v = static_cast<char>(image.pixels[k]);
-      for (int c = 0; c < e.bytes; ++c)
-        rows[k * e.bytes + c] = e.bytes == 2 && c == 1 ? '\x80' : v;  // yuyv: U and V neutral
-    }
-    messages.push_back(test::raw_image_cdr(0, "omni", e.name, image.width, image.height,
-                                           image.width * e.bytes, rows));
-  }
+  for (const Image8& image : f.images)
+    messages.push_back(test::raw_image_cdr(0, "omni", encoding, image.width, image.height,
+                                           image.width * bytes,
+                                           test::raw_rows(image.pixels, encoding)));
   std::size_t k = 0;
   for (auto _ : state) {
     const io::ros2::GreyImage g = io::ros2::raw_image_grey(messages[k++ % messages.size()]);
     benchmark::DoNotOptimize(g.image.pixels.data());
   }
-  state.SetLabel(e.name);
+  state.SetLabel(encoding);
 }
 BENCHMARK(BM_ReadRawOmniFrame)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
 

@@ -10,10 +10,10 @@
 #include <fstream>
 #include <map>
 #include <memory>
-#include <sstream>
 #include <tuple>
 
 #include "lampnav/core/error.hpp"
+#include "lampnav/internal/json_util.hpp"
 
 namespace lampnav::io {
 
@@ -58,14 +58,6 @@ std::string unzstd(const std::string& in, std::uint64_t max_bytes) {
     if (src.pos == src.size && dst.pos < chunk) throw std::string("zstd: the data ends in a frame");
     if (dst.pos == 0 && src.pos == consumed) throw std::string("zstd: no progress");
   }
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError({path, "", ""}, "cannot open the file for reading");
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
 }
 
 // The first bytes of a file, to tell its container.
@@ -348,7 +340,7 @@ McapFile read_file(const std::string& path) {
   if (is_zstd(magic)) {  // --compression-mode file
     std::string bytes;
     try {
-      bytes = unzstd(slurp(path), kMaxFileBytes);
+      bytes = unzstd(json::read_file(path), kMaxFileBytes);
     } catch (const std::string& why) {
       throw InputError({path, "", ""}, "a zstd-compressed file that does not decompress: " + why);
     }

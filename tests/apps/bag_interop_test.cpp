@@ -9,7 +9,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <map>
 #include <sstream>
 
 #include "cli_support.hpp"
@@ -85,12 +84,8 @@ TEST(BagInterop, ABagWrittenByRos2ToolingReplaysAsTheMission) {
     const std::size_t half = f.messages.size() / 2;
     for (int part = 0; part < 2; ++part) {
       test::Rosbag2SqliteWriter w(db3 + "/corridor_db3_" + std::to_string(part) + ".db3");
-      std::map<std::uint16_t, std::int64_t> topic_of;
-      for (const auto& ch : f.channels)
-        topic_of[ch.id] = w.topic(ch.topic, f.schema(ch.schema_id)->name, ch.message_encoding);
-      for (std::size_t k = part == 0 ? 0 : half; k < (part == 0 ? half : f.messages.size()); ++k)
-        w.write(topic_of[f.messages[k].channel_id],
-                static_cast<std::int64_t>(f.messages[k].log_time), f.messages[k].data, part == 1);
+      w.copy(f, part == 0 ? 0 : half, part == 0 ? half : f.messages.size(),
+             [&](const io::McapMessage&) { return part == 1; });
     }
     std::ofstream(db3 + "/metadata.yaml")
         << "rosbag2_bagfile_information:\n  version: 9\n  storage_identifier: sqlite3\n"

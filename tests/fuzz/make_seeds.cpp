@@ -108,12 +108,9 @@ std::string db3_bytes() {
   fs::remove(tmp);
   {
     test::Rosbag2SqliteWriter w(tmp.string());
-    std::map<std::uint16_t, std::int64_t> topic_of;
-    for (const auto& ch : bag.channels)
-      topic_of[ch.id] = w.topic(ch.topic, bag.schema(ch.schema_id)->name);
-    for (const auto& m : bag.messages)
-      w.write(topic_of[m.channel_id], static_cast<std::int64_t>(m.log_time), m.data,
-              bag.channel(m.channel_id)->topic.find("image") != std::string::npos);
+    w.copy(bag, 0, bag.messages.size(), [&](const io::McapMessage& m) {
+      return bag.channel(m.channel_id)->topic.find("image") != std::string::npos;
+    });
   }
   std::string b = slurp(tmp);
   fs::remove(tmp);

@@ -105,19 +105,15 @@ int main(int argc, char** argv) {
   }
   // Raw frames are decoded and laid out in their encoding before playing, as a camera driver
   // hands them over.
-  const int bytes = o.raw_encoding == "bgr8" ? 3 : o.raw_encoding == "yuyv" ? 2 : 1;
+  const int bytes = test::raw_bytes_per_pixel(o.raw_encoding);
   struct Raw {
     std::uint32_t width, height;
     std::string rows;
   };
   auto raw = [&](const io::ImageFrame& f) {
     const Image8 g = io::decode_image(f.data, o.log);
-    Raw r{static_cast<std::uint32_t>(g.width), static_cast<std::uint32_t>(g.height),
-          std::string(g.pixels.size() * bytes, '\0')};
-    for (std::size_t k = 0; k < g.pixels.size(); ++k)
-      for (int c = 0; c < bytes; ++c)  // yuyv: Y, then U or V, neutral
-        r.rows[k * bytes + c] = bytes == 2 && c == 1 ? '\x80' : static_cast<char>(g.pixels[k]);
-    return r;
+    return Raw{static_cast<std::uint32_t>(g.width), static_cast<std::uint32_t>(g.height),
+               test::raw_rows(g.pixels, o.raw_encoding)};
   };
   std::vector<Raw> raw_ceiling, raw_omni;
   if (o.raw) {

@@ -35,6 +35,19 @@ inline std::string raw_image_cdr(std::int64_t stamp_ns, const std::string& frame
       .bytes(rows)
       .take();
 }
+// A grey frame's pixels laid out as `encoding` holds them, every sample the grey (bgr8: three
+// alike; yuyv: Y the grey, U and V neutral; bayer_rggb8: each site the grey), rows unpadded.
+inline int raw_bytes_per_pixel(const std::string& encoding) {
+  return encoding == "bgr8" ? 3 : encoding == "yuyv" ? 2 : 1;
+}
+inline std::string raw_rows(const std::vector<std::uint8_t>& grey, const std::string& encoding) {
+  const int bytes = raw_bytes_per_pixel(encoding);
+  std::string rows(grey.size() * bytes, '\0');
+  for (std::size_t k = 0; k < grey.size(); ++k)
+    for (int c = 0; c < bytes; ++c)
+      rows[k * bytes + c] = bytes == 2 && c == 1 ? '\x80' : static_cast<char>(grey[k]);
+  return rows;
+}
 inline std::string mono8_image_cdr(std::int64_t stamp_ns, const std::string& frame,
                                    std::uint32_t width, std::uint32_t height, std::uint32_t step,
                                    const std::string& rows) {

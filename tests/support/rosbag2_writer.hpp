@@ -8,8 +8,11 @@
 #include <zstd.h>
 
 #include <cstdint>
+#include <map>
 #include <stdexcept>
 #include <string>
+
+#include "lampnav/io/mcap.hpp"
 
 namespace lampnav::test {
 
@@ -63,6 +66,18 @@ class Rosbag2SqliteWriter {
     sqlite3_bind_int64(insert_, 2, t_ns);
     sqlite3_bind_blob(insert_, 3, stored.data(), static_cast<int>(stored.size()), SQLITE_TRANSIENT);
     if (sqlite3_step(insert_) != SQLITE_DONE) fail("insert");
+  }
+  // Messages [begin, end) of an MCAP bag, every one of its topics first; `compress(message)`
+  // says which to store compressed.
+  template <class Compress>
+  void copy(const io::McapFile& bag, std::size_t begin, std::size_t end, Compress compress) {
+    std::map<std::uint16_t, std::int64_t> topic_of;
+    for (const auto& ch : bag.channels)
+      topic_of[ch.id] = topic(ch.topic, bag.schema(ch.schema_id)->name, ch.message_encoding);
+    for (std::size_t k = begin; k < end && k < bag.messages.size(); ++k) {
+      const io::McapMessage& m = bag.messages[k];
+      write(topic_of[m.channel_id], static_cast<std::int64_t>(m.log_time), m.data, compress(m));
+    }
   }
   void exec(const std::string& sql) {
     if (sqlite3_exec(db_, sql.c_str(), nullptr, nullptr, nullptr) != SQLITE_OK) fail(sql);
