@@ -9,6 +9,7 @@
 #include "lampnav/core/error.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "omni_ways.hpp"
+#include "seen_ways.hpp"
 
 namespace lampnav::mapping {
 
@@ -43,6 +44,7 @@ void TopologyOptions::validate() const {
   check(way_clear_m >= 0, "way_clear_m", "must not be negative");
   check(way_min_angle_deg > 0 && way_min_angle_deg <= 90, "way_min_angle_deg",
         "must be 0 to 90 degrees");
+  check(rows_reach_m >= 0, "rows_reach_m", "must not be negative");
 }
 
 namespace {
@@ -134,74 +136,6 @@ graph::Polygon rectangle(const Vector2d& a, const Vector2d& b, double width) {
   const Vector2d d = (b - a).normalized();
   const Vector2d n(-d.y() * width / 2, d.x() * width / 2);
   return graph::Polygon({a - n, b - n, b + n, a + n});
-}
-
-// Ways out not driven: rows of the lamps seen around the drive (not the runs' own) that start
-// beside a run and go away from it, each alone (no other such row beside it, at most one lamp
-// off its line near it).
-struct SeenWay {
-  Vector2d at, way;  // where its row's line crosses the run, and the way from there
-  Vector2d middle;   // of the row
-};
-
-std::vector<SeenWay> ways_not_driven(const std::vector<Line>& lines, const std::vector<Run>& runs,
-                                     const std::vector<Vector2d>& seen, const TopologyOptions& o) {
-  std::vector<SeenWay> out;
-  if (o.way_min_lamps == 0 || seen.empty()) return out;
-  std::vector<Vector2d> around;
-  for (const Vector2d& p : seen) {
-    bool own = false;
-    for (const auto& r : runs) {
-      const Line& L = lines[r.line];
-      const double s = L.along(p);
-      own = own || (L.across(p) < o.same_line_m && s > r.s0 - o.place_m && s < r.s1 + o.place_m);
-    }
-    if (!own) around.push_back(p);
-  }
-  const double min_sin = std::sin(o.way_min_angle_deg * M_PI / 180);
-  for (const LampRow& row : lamp_rows(around, o.way_min_lamps, o.way_across_m, o.way_gap_m)) {
-    const Vector2d u = row.dir();
-    // A corridor's row has at most a lamp beside it (a room's, through a door): lamps off the
-    // row's line but near it (a column or a diagonal of a room's grid of lamps) make it no way.
-    const double length = (row.last - row.first).norm();
-    int beside = 0;
-    for (const Vector2d& p : around) {
-      const Vector2d e = p - row.first;
-      const double off = std::abs(u.x() * e.y() - u.y() * e.x()), s = u.dot(e);
-      beside += off > 4 * o.way_across_m && off < o.way_clear_m && s > -o.way_clear_m &&
-                s < length + o.way_clear_m;
-    }
-    if (beside > 1) continue;
-    for (const auto& r : runs) {
-      const Line& L = lines[r.line];
-      const double cross = L.dir.x() * u.y() - L.dir.y() * u.x();
-      if (std::abs(cross) < min_sin) continue;
-      // Where the row's line meets the run's, and the row's ends from there along the row.
-      const Vector2d d = row.first - L.origin;
-      const double s = (d.x() * u.y() - d.y() * u.x()) / cross;
-      if (s < r.s0 - o.place_m || s > r.s1 + o.place_m) continue;
-      const Vector2d at = L.at(s);
-      const double a = (row.first - at).dot(u), b = (row.last - at).dot(u);
-      if (a * b <= 0 || std::min(std::abs(a), std::abs(b)) > o.way_first_lamp_m) continue;
-      out.push_back({at, a > 0 ? u : Vector2d(-u), 0.5 * (row.first + row.last)});
-    }
-  }
-  // A corridor's lamps are one row; rows side by side going the same way (a room's or a hall's
-  // grid of lamps, seen through walls or a door) are no way out.
-  const double same_way = std::cos(15 * M_PI / 180);
-  std::vector<SeenWay> alone;
-  for (const SeenWay& x : out) {
-    bool beside = false;
-    for (const SeenWay& y : out) {
-      // Apart across the way (rows through some of the same lamps are not side by side).
-      const Vector2d e = y.middle - x.at;
-      const double apart = std::abs(x.way.x() * e.y() - x.way.y() * e.x());
-      beside = beside || (y.way.dot(x.way) > same_way && apart > o.way_across_m + 0.7 &&
-                          apart < o.way_beside_m);
-    }
-    if (!beside) alone.push_back(x);
-  }
-  return alone;
 }
 
 }  // namespace
@@ -312,7 +246,7 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     if (r.hall1 < 0) add_place(lines[r.line].at(r.s1));
   }
   // 2b. Ways out not driven, seen: where one meets a run is a place.
-  const std::vector<SeenWay> seen_ways = ways_not_driven(lines, runs, seen, o);
+  const std::vector<SeenWay> seen_ways = ways_not_driven(lines, runs, mapped.lamps, seen, o);
   for (const SeenWay& x : seen_ways) add_place(x.at);
   // Ways out of each place: the runs that go on from it by more than a place's size.
   // Where a point lies along a run (the distance along its line), if the run passes it.

@@ -521,6 +521,73 @@ TEST(MapBuild, LampsEightMetresUpAreMappedAsWell) {
     for (const auto& l : n.lamps) EXPECT_NEAR(l.xyz.z(), 8.0, 0.03) << l.id.value;
 }
 
+// The office with two rows of lamps in its corridors, 1.5 m apart (a wide corridor's troffers),
+// driven E1 -> J1 -> J2 -> E2 on rendered frames: far down a side corridor the omni camera sees a
+// pair of lamps as one blob between them, near as two, and lines through a lamp of one row and
+// the next of the other are rows as well, askew. The junctions turned at have their ways out, once
+// each, and no place lies where none is; every lamp passed under is in the map once. Before,
+// rows side by side were a room's grid: both junctions came out corners; without taking the askew
+// rows of one way as one, the drive had a junction in the middle of C5.
+TEST(MapBuild, CorridorsOfTwoRowsKeepTheirWaysOut) {
+  nlohmann::json doc =
+      nlohmann::json::parse(test::slurp(test::source_path("maps/office_floor.geojson")));
+  for (auto& f : doc["features"]) {
+    const auto& md = f["properties"]["metadata"];
+    if (!f["properties"].contains("lampnav") || !md.contains("place") || md["place"] == "room" ||
+        md["place"] == "door")
+      continue;
+    Eigen::Vector2d along(1, 0);
+    if (md.contains("axis"))
+      along = Eigen::Vector2d(
+                  md["axis"]["x_values"][1].get<double>() - md["axis"]["x_values"][0].get<double>(),
+                  md["axis"]["y_values"][1].get<double>() - md["axis"]["y_values"][0].get<double>())
+                  .normalized();
+    nlohmann::json rows = nlohmann::json::array();
+    for (const auto& l : f["properties"]["lampnav"]["lamps"])
+      for (const double side : {0.75, -0.75}) {
+        auto c = l;
+        c["id"] = l["id"].get<std::string>() + (side > 0 ? "a" : "b");
+        c["xyz"][0] = l["xyz"][0].get<double>() - side * along.y();
+        c["xyz"][1] = l["xyz"][1].get<double>() + side * along.x();
+        rows.push_back(c);
+      }
+    f["properties"]["lampnav"]["lamps"] = rows;
+  }
+  const fs::path dir =
+      fs::temp_directory_path() / ("lampnav_two_rows_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string map = (dir / "two_rows.geojson").string(), log = (dir / "drive.mcap").string(),
+                    out = (dir / "built.geojson").string();
+  std::ofstream(map) << doc.dump();
+  const auto sim =
+      test::run_lampnav("sim --route 'E1 -> E2' --seed 5 --map '" + map + "' --robot " +
+                        test::quoted_source("maps/robots/pioneer.json") + " -q -o '" + log + "'");
+  ASSERT_EQ(sim.status, 0) << sim.err;
+  const auto r = test::run_lampnav("map build '" + log + "' -o '" + out + "' --quiet");
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::cout << r.out;
+  const graph::TopologicalMap truth = graph::read_map(map).map, built = graph::read_map(out).map;
+  const Pose2 start = io::read_mission_log(log).truth.front().value.pose;
+  const LampErrors e = lamp_errors(built, truth, start);
+  std::size_t under = 0;
+  for (const char* name : {"E1", "C1", "J1", "C5", "J2", "C6", "E2"})
+    under += truth.find_node(name)->lamps.size();
+  EXPECT_EQ(e.matched.size(), under);
+  std::cout << e.matched.size() << " lamps, error rms " << e.rms * 100 << " cm, max "
+            << e.worst * 100 << " cm\n";
+  std::map<std::string, std::string> kinds;  // the true place holding each built place: its kind
+  for (const auto& n : built.nodes()) {
+    if (n.place == graph::Place::corridor) continue;
+    const graph::Node* t = truth.node_containing(start.transform_from(n.point));
+    kinds[t ? t->name : "nowhere"] = graph::to_string(n.place);
+  }
+  const std::map<std::string, std::string> want = {
+      {"E1", "end"}, {"J1", "junction"}, {"J2", "junction"}, {"E2", "end"}};
+  EXPECT_EQ(kinds, want);
+  EXPECT_EQ(built.node_count(), 7u);  // and three corridors
+  fs::remove_all(dir);
+}
+
 // A map built from one drive along C1 and C2 (anchored at the drive's true start), then another
 // drive of the same corridors replayed on it and on the true map: the same accuracy within 1 cm.
 TEST(MapBuild, ReplayOnTheBuiltMapIsAsGoodAsOnTheTrueMap) {

@@ -12,6 +12,7 @@
 #include <set>
 
 #include "drive.hpp"
+#include "edited_map.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/graph/map_checks.hpp"
 #include "lampnav/mapping/rigid_fit.hpp"
@@ -385,6 +386,36 @@ TEST(Topology, WaysOutTheOmniCameraSawGivePlacesTheirTrueKind) {
     EXPECT_FALSE(places_of_another_kind(driven, office.map, drive.start).empty());
     EXPECT_EQ(alone.ways_seen, 0u);
     for (const auto& note : rep.notes) std::cout << name << ": " << note << "\n";
+  }
+}
+
+// The same drives on the office with two rows of lamps in every corridor, 1.2 m apart (a wide
+// corridor's troffers). Rows side by side are a room's grid to the ways' test; the driven
+// corridors' lamps say how far apart a corridor's rows stand, and the ways out are bands that
+// wide. Before, every way out was taken for a room's grid: no place of its true kind but the ends.
+TEST(Topology, WaysOutOfCorridorsOfTwoRows) {
+  test::Office office;
+  office.map = test::edited(office.map, [](graph::Node& n) { test::two_rows(n, 0.6); });
+  test::DriveOptions o;
+  o.omni_rate = 3;
+  const std::vector<std::pair<std::string, std::vector<Vector2d>>> drives = {
+      {"E1 -> J1 -> J2 -> E2", {{1, 10}, {21, 10}, {21, -8}, {1, -8}}},
+      {"K1 -> J1 -> E1", {{41, 10}, {1, 10}}},
+      {"E1 -> J1 -> J2 -> K2", {{1, 10}, {21, 10}, {21, -8}, {41, -8}}},
+      {"E2 -> J2 -> K2 -> K1", {{1, -8}, {41, -8}, {41, 10}}},
+  };
+  for (const auto& [name, waypoints] : drives) {
+    SCOPED_TRACE(name);
+    const test::DriveRecord drive = office.drive(waypoints, o);
+    const MappingResult mapped = test::map_drive(drive, office.robot);
+    TopologyReport rep, alone;
+    const graph::TopologicalMap built =
+        build_topology(mapped, {}, {}, &rep, seen_around(drive, mapped, office.robot));
+    const auto wrong = places_of_another_kind(built, office.map, drive.start);
+    EXPECT_TRUE(wrong.empty()) << ::testing::PrintToString(wrong);
+    EXPECT_GE(rep.ways_seen, 1u);
+    const graph::TopologicalMap driven = build_topology(mapped, {}, {}, &alone);
+    EXPECT_FALSE(places_of_another_kind(driven, office.map, drive.start).empty());
   }
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Test maps edited from the bundled ones: lamps made round, moved, added or taken out.
 
+#include <cmath>
 #include <functional>
 
 #include "lampnav/graph/map.hpp"
@@ -40,6 +41,28 @@ inline void sparse_round(graph::Node& n) {
     n.lamps = kept;
   }
   make_round(n);
+}
+
+// The node's lamps hung in two rows, each lamp replaced by two `offset` m either side of it across
+// its corridor (across the lamp's axis at a junction, corner or end): a wide corridor's two rows
+// of troffers. Rooms, doors and halls as they were.
+inline void two_rows(graph::Node& n, double offset) {
+  if (n.place == graph::Place::room || n.place == graph::Place::door ||
+      n.place == graph::Place::hall)
+    return;
+  std::vector<graph::Lamp> rows;
+  for (const graph::Lamp& l : n.lamps) {
+    const Eigen::Vector2d along =
+        n.axis ? n.axis->direction() : Eigen::Vector2d(std::cos(l.yaw), std::sin(l.yaw));
+    const Eigen::Vector2d across(-along.y(), along.x());
+    for (const auto& [side, tag] : {std::pair{1.0, "a"}, std::pair{-1.0, "b"}}) {
+      graph::Lamp c = l;
+      c.id = LampId{l.id.value + tag};
+      c.xyz.head<2>() += side * offset * across;
+      rows.push_back(c);
+    }
+  }
+  n.lamps = rows;
 }
 
 }  // namespace lampnav::test

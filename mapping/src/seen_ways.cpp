@@ -1,0 +1,143 @@
+#include "seen_ways.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "median.hpp"
+#include "omni_ways.hpp"
+
+namespace lampnav::mapping::drive_topology {
+
+using Eigen::Vector2d;
+
+namespace {
+
+// How far apart across a corridor its lamps stand, from the lamps the drive passed under: half
+// the spread (10th to 90th percentile) of their offsets from each run's line, within
+// `rows_reach_m` of it and along it, the median over runs of at least 4 such lamps. Near 0 where a
+// corridor has one row (the robot drives under it, weaving a little); half the rows' spacing where
+// it has two (a wide corridor's two rows of troffers). The offsets are signed, so a drive along one
+// side of the corridor measures the same.
+double rows_half_spread(const std::vector<Line>& lines, const std::vector<Run>& runs,
+                        const std::vector<MappedLamp>& lamps, const TopologyOptions& o) {
+  std::vector<double> halves, offsets;
+  for (const auto& r : runs) {
+    const Line& L = lines[r.line];
+    offsets.clear();
+    for (const MappedLamp& l : lamps) {
+      const Vector2d p = l.xyz.head<2>(), d = p - L.origin;
+      const double s = L.along(p), across = d.x() * L.dir.y() - d.y() * L.dir.x();
+      if (s >= r.s0 && s <= r.s1 && std::abs(across) <= o.rows_reach_m) offsets.push_back(across);
+    }
+    if (offsets.size() < 4) continue;
+    std::sort(offsets.begin(), offsets.end());
+    const std::size_t n = offsets.size() - 1, lo = n / 10, hi = n - n / 10;
+    halves.push_back((offsets[hi] - offsets[lo]) / 2);
+  }
+  return halves.empty() ? 0.0 : median(halves);
+}
+
+}  // namespace
+
+std::vector<SeenWay> ways_not_driven(const std::vector<Line>& lines, const std::vector<Run>& runs,
+                                     const std::vector<MappedLamp>& lamps,
+                                     const std::vector<Vector2d>& seen, const TopologyOptions& o) {
+  std::vector<SeenWay> out;
+  if (o.way_min_lamps == 0 || seen.empty()) return out;
+  // Corridors of two rows (or more): a way's lamps stand in a band as wide as the driven
+  // corridors' rows, not on one line; the omni camera sees a far pair of lamps side by side as one
+  // blob between them, a near pair as two. The band is 0 for one row (every figure as before).
+  const double half_spread = rows_half_spread(lines, runs, lamps, o);
+  const double band = half_spread > o.way_across_m ? half_spread : 0.0;
+  const double across = o.way_across_m + band;
+  std::vector<Vector2d> around;
+  for (const Vector2d& p : seen) {
+    bool own = false;
+    for (const auto& r : runs) {
+      const Line& L = lines[r.line];
+      const double s = L.along(p);
+      own = own ||
+            (L.across(p) < o.same_line_m + band && s > r.s0 - o.place_m && s < r.s1 + o.place_m);
+    }
+    if (!own) around.push_back(p);
+  }
+  const double min_sin = std::sin(o.way_min_angle_deg * M_PI / 180);
+  for (const LampRow& row : lamp_rows(around, o.way_min_lamps, across, o.way_gap_m)) {
+    const Vector2d u = row.dir();
+    // A corridor's row has at most a lamp beside it (a room's, through a door): lamps off the
+    // row's line but near it (a column or a diagonal of a room's grid of lamps) make it no way.
+    // A corridor of two rows has its other row beside it, within the band of its rows.
+    const double length = (row.last - row.first).norm();
+    int beside = 0;
+    for (const Vector2d& p : around) {
+      const Vector2d e = p - row.first;
+      const double off = std::abs(u.x() * e.y() - u.y() * e.x()), s = u.dot(e);
+      beside += off > 4 * o.way_across_m + 2 * band && off < o.way_clear_m && s > -o.way_clear_m &&
+                s < length + o.way_clear_m;
+    }
+    if (beside > 1) continue;
+    for (const auto& r : runs) {
+      const Line& L = lines[r.line];
+      const double cross = L.dir.x() * u.y() - L.dir.y() * u.x();
+      if (std::abs(cross) < min_sin) continue;
+      // Where the row's line meets the run's, and the row's ends from there along the row.
+      const Vector2d d = row.first - L.origin;
+      const double s = (d.x() * u.y() - d.y() * u.x()) / cross;
+      if (s < r.s0 - o.place_m || s > r.s1 + o.place_m) continue;
+      const Vector2d at = L.at(s);
+      const double a = (row.first - at).dot(u), b = (row.last - at).dot(u);
+      if (a * b <= 0 || std::min(std::abs(a), std::abs(b)) > o.way_first_lamp_m) continue;
+      out.push_back({at, a > 0 ? u : Vector2d(-u), 0.5 * (row.first + row.last), row.lamps});
+    }
+  }
+  // A corridor's lamps are one row (or one band of rows); rows side by side going the same way (a
+  // room's or a hall's grid of lamps, seen through walls or a door) are no way out.
+  const double same_way = std::cos(15 * M_PI / 180);
+  std::vector<SeenWay> alone;
+  for (const SeenWay& x : out) {
+    bool beside = false;
+    for (const SeenWay& y : out) {
+      // Apart across the way (rows through some of the same lamps are not side by side).
+      const Vector2d e = y.middle - x.at;
+      const double apart = std::abs(x.way.x() * e.y() - x.way.y() * e.x());
+      beside =
+          beside || (y.way.dot(x.way) > same_way && apart > across + 0.7 && apart < o.way_beside_m);
+    }
+    if (!beside) alone.push_back(x);
+  }
+  if (band == 0) return alone;
+  // In a band of rows, few lamps are seen down a way (a far pair is one blob), and lines through a
+  // lamp of one row and the next of the other hold as many as the band's own: each way is found
+  // several times, askew by up to 30 degrees, crossing the run up to 2 m from where it meets it.
+  // Ways within 50 degrees of each other crossing within twice a place's size are one, along
+  // their mean (weighted by their lamps), from the mean of their crossings.
+  const double alike = std::cos(50 * M_PI / 180),
+               reach = 2 * std::max(o.place_m, o.corridor_width_m);
+  std::stable_sort(alone.begin(), alone.end(),
+                   [](const SeenWay& x, const SeenWay& y) { return x.lamps > y.lamps; });
+  struct Group {
+    SeenWay first;
+    Vector2d at = Vector2d::Zero(), way = Vector2d::Zero(), middle = Vector2d::Zero();
+    double weight = 0;
+  };
+  std::vector<Group> groups;
+  for (const SeenWay& x : alone) {
+    Group* g = nullptr;
+    for (Group& h : groups)
+      if (!g && (h.first.at - x.at).norm() < reach && h.first.way.dot(x.way) > alike) g = &h;
+    if (!g) {
+      groups.push_back({x});
+      g = &groups.back();
+    }
+    g->at += x.lamps * x.at;
+    g->way += x.lamps * x.way;
+    g->middle += x.lamps * x.middle;
+    g->weight += x.lamps;
+  }
+  std::vector<SeenWay> kept;
+  for (const Group& g : groups)
+    kept.push_back({g.at / g.weight, g.way.normalized(), g.middle / g.weight, g.first.lamps});
+  return kept;
+}
+
+}  // namespace lampnav::mapping::drive_topology
