@@ -27,6 +27,9 @@ void BuildingOptions::validate() const {
         "must be 0 to 1000");
   check(wing_lamp_spacing_m == 0 || (wing_lamp_spacing_m >= 0.5 && wing_lamp_spacing_m < block_m),
         "wing_lamp_spacing_m", "must be 0 (none) or at least 0.5 m and less than a block");
+  check(rows == 1 || rows == 2, "rows", "must be 1 or 2");
+  check(row_spacing_m >= 0.5 && row_spacing_m <= 1.8, "row_spacing_m",
+        "must be 0.5 to 1.8 m (the rows stay inside the 2 m corridor)");
 }
 
 namespace {
@@ -152,6 +155,13 @@ Building generate_building(const BuildingOptions& o) {
     }
   }
   b.missing.assign(missing.begin(), missing.end());
+  // A corridor's lamp (or a junction's) at (x, y) along `yaw`: one, or two across it.
+  auto row_lamps = [&](Json& props, const std::string& id, double x, double y, double yaw) {
+    if (o.rows == 1) return w.lamp(props, id, x, y, z, yaw, false);
+    const double h = 0.5 * o.row_spacing_m;
+    w.lamp(props, id + "a", x - h * std::sin(yaw), y + h * std::cos(yaw), z, yaw, false);
+    w.lamp(props, id + "b", x + h * std::sin(yaw), y - h * std::cos(yaw), z, yaw, false);
+  };
   // Junctions: a corner where two corridors meet at a right angle, a junction where more do.
   auto exits = [&](int i, int j) {
     int n = 0;
@@ -171,7 +181,7 @@ Building generate_building(const BuildingOptions& o) {
       const char* place = n <= 1 ? "end" : n == 2 && !straight ? "corner" : "junction";
       const double x = i * S, y = j * S;
       Json& props = w.node(J(i, j), place, x, y, Writer::region(x - 1, y - 1, x + 1, y + 1));
-      w.lamp(props, J(i, j) + "-L1", x, y, z, 0.0, false);
+      row_lamps(props, J(i, j) + "-L1", x, y, 0.0);
     }
   auto corridor = [&](const std::string& name, double x0, double y0, double x1, double y1,
                       bool room_door) {
@@ -189,8 +199,8 @@ Building generate_building(const BuildingOptions& o) {
     const double first = 0.5 * (len - (n - 1) * spacing);
     for (int q = 0; q < n; ++q) {
       const double s = first + q * spacing;
-      w.lamp(props, name + "-L" + std::to_string(q + 1), horizontal ? x0 + s : x0,
-             horizontal ? y0 : y0 + s, z, horizontal ? 0.0 : M_PI / 2, false);
+      row_lamps(props, name + "-L" + std::to_string(q + 1), horizontal ? x0 + s : x0,
+                horizontal ? y0 : y0 + s, horizontal ? 0.0 : M_PI / 2);
     }
     if (room_door)
       props["lampnav"]["doors"] =

@@ -80,6 +80,24 @@ TEST(Hypotheses, GridOfficeKidnapsIntoLookAlikeCorridors) {
   }
 }
 
+// The same office with two rows of lamps 1.2 m apart in every corridor and over every junction (a
+// wide corridor's troffers): twice the look-alike lamps, each pair a twin of its neighbours, and
+// a lamp beside each one that a label could swap with.
+TEST(Hypotheses, GridOfficeOfTwoRowsKidnapsIntoLookAlikeCorridors) {
+  sim::BuildingOptions o = grid_office();
+  o.rows = 2;
+  const Building w(o);
+  test::Battery battery(w.map, w.robot);
+  std::vector<test::EpisodeResult> rs;
+  for (std::uint64_t seed = 1; seed <= 12; ++seed) rs.push_back(battery.kidnap(seed));
+  std::cout << w.b.lamps << " lamps: " << test::summarize(rs) << "\n";
+  for (const auto& r : rs) {
+    EXPECT_EQ(r.wrong_fixes, 0);
+    EXPECT_TRUE(r.detected);
+    EXPECT_TRUE(r.fix_correct) << r.last_why;
+  }
+}
+
 // The hypotheses of a frame are weighed, and an image's candidates searched, on every core: the
 // same kidnaps on one core give every hypothesis of every frame to the last bit.
 TEST(Hypotheses, WeighingOnEveryCoreChangesNothing) {
@@ -155,8 +173,10 @@ test::BatteryOptions traced() {
 
 // Every episode detected, never a wrong fix, every fix right; at least `must_fix` episodes fixed
 // within the drive (the others end saying "one of these").
-void kidnaps_on(int nodes, int episodes, int must_fix) {
-  const Building w(test::asymmetric_building(nodes));
+void kidnaps_on(int nodes, int episodes, int must_fix, int rows = 1) {
+  sim::BuildingOptions o = test::asymmetric_building(nodes);
+  o.rows = rows;
+  const Building w(o);
   test::Battery battery(w.map, w.robot, traced());
   std::vector<test::EpisodeResult> rs;
   for (int k = 1; k <= episodes; ++k) {
@@ -228,6 +248,8 @@ TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf10Nodes) { kidnaps_on(10, 10, 10);
 // 10-node battery runs the same code.
 TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf1000Nodes) { kidnaps_on(1000, 10, 9); }
 TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf100Nodes) { kidnaps_on(100, 10, 10); }
+// Its corridors with two rows of lamps 1.2 m apart (over the junctions too).
+TEST(Hypotheses, KidnapsOnAGeneratedBuildingOf100NodesOfTwoRows) { kidnaps_on(100, 10, 10, 2); }
 
 // A floor that swings both cameras by 1.5 degrees from frame to frame (three times what the
 // models assume), the robot carried at random (the rough-floor battery's episode 5019). Its

@@ -54,6 +54,49 @@ TEST(Building, SameSeedSameMapAndBadOptionsRefused) {
   bad = {};
   bad.lamp_spacing_m = 0;
   EXPECT_THROW(generate_building(bad), InputError);
+  bad = {};
+  bad.rows = 3;
+  EXPECT_THROW(generate_building(bad), InputError);
+  bad = {};
+  bad.rows = 2;
+  bad.row_spacing_m = 2.5;  // outside the corridor
+  EXPECT_THROW(generate_building(bad), InputError);
+}
+
+// Two rows: each corridor and junction lamp becomes a pair `row_spacing_m` apart across the
+// corridor, about where the one lamp hung, inside the node's region; rooms keep theirs.
+TEST(Building, TwoRowsHangEachLampAsAPairAcrossTheCorridor) {
+  BuildingOptions one;
+  one.nodes = 30;
+  BuildingOptions two = one;
+  two.rows = 2;
+  two.row_spacing_m = 1.4;
+  const graph::LoadedMap a = graph::parse_map(generate_building(one).geojson, "one");
+  const graph::LoadedMap b = graph::parse_map(generate_building(two).geojson, "two");
+  EXPECT_EQ(b.warnings.size(), 0u);
+  ASSERT_EQ(a.map.node_count(), b.map.node_count());
+  for (const auto& n : a.map.nodes()) {
+    const graph::Node& m = *b.map.find_node(n.name);
+    if (n.place == graph::Place::room) {
+      EXPECT_EQ(m.lamps.size(), n.lamps.size()) << n.name;
+      continue;
+    }
+    ASSERT_EQ(m.lamps.size(), 2 * n.lamps.size()) << n.name;
+    for (std::size_t k = 0; k < n.lamps.size(); ++k) {
+      const auto& l = n.lamps[k];
+      const auto& p = m.lamps[2 * k];
+      const auto& q = m.lamps[2 * k + 1];
+      EXPECT_EQ(p.id.value, l.id.value + "a");
+      EXPECT_NEAR((p.xyz - q.xyz).norm(), 1.4, 1e-9) << l.id.value;
+      EXPECT_LT(((p.xyz + q.xyz) / 2 - l.xyz).norm(), 1e-9) << l.id.value;
+      // Across the lamp's axis (the corridor's), not along it.
+      EXPECT_NEAR(
+          std::abs(std::cos(l.yaw) * (p.xyz - q.xyz).x() + std::sin(l.yaw) * (p.xyz - q.xyz).y()),
+          0, 1e-9);
+      EXPECT_EQ(b.map.node_containing(p.xyz.head<2>()), &m) << p.id.value;
+      EXPECT_EQ(b.map.node_containing(q.xyz.head<2>()), &m) << q.id.value;
+    }
+  }
 }
 
 }  // namespace
