@@ -3,6 +3,7 @@
 // lampnav map survey M LOG.mcap [--robot R.json] [--json] [--update OUT.geojson]
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -194,7 +195,14 @@ int run_survey(const SurveyArgs& a) {
             << " lamps in clear view, " << s.ok << " where the map has them; " << failed
             << " failed, " << moved << " moved, " << added << " new\n";
   if (!s.findings.empty()) {
-    std::cout << std::left << std::setw(8) << "status" << std::setw(12) << "lamp" << std::setw(34)
+    // Columns as wide as their longest entry (place names and lamp ids are the map's own).
+    std::size_t lamp_w = 10, where_w = 32;
+    for (const auto& f : s.findings) {
+      lamp_w = std::max(lamp_w, f.lamp.size());
+      where_w = std::max(where_w, f.where.size());
+    }
+    const int lw = static_cast<int>(lamp_w + 2), ww = static_cast<int>(where_w + 2);
+    std::cout << std::left << std::setw(8) << "status" << std::setw(lw) << "lamp" << std::setw(ww)
               << "where"
               << "detail\n";
     for (const auto& f : s.findings) {
@@ -207,8 +215,8 @@ int run_survey(const SurveyArgs& a) {
                       f.seen_xyz.y(), f.seen_xyz.z());
       else
         std::snprintf(detail, sizeof detail, "in view, never lit");
-      std::cout << std::setw(8) << mapping::to_string(f.status) << std::setw(12) << f.lamp
-                << std::setw(34) << f.where << detail << "\n";
+      std::cout << std::setw(8) << mapping::to_string(f.status) << std::setw(lw) << f.lamp
+                << std::setw(ww) << f.where << detail << "\n";
     }
   }
   if (!a.update.empty()) std::cout << "corrected map: " << a.update << "\n";

@@ -1,6 +1,7 @@
 #include "lampnav/mapping/survey.hpp"
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -84,9 +85,39 @@ std::string describe(const graph::TopologicalMap& map, const graph::Node& n, con
   }
   const auto order = map.lamps_in_walking_order(
       n.id, from_first ? graph::Travel::forward : graph::Travel::backward);
-  for (std::size_t i = 0; i < order.size(); ++i)
-    if (order[i]->id == lamp->id)
-      return n.name + ", " + graph::ordinal_number(int(i) + 1) + " lamp from " + from;
+  // A corridor of two rows (or more): the lamp's row, left or right walking from `from`, and its
+  // place in that row. Rows are the lamps' offsets across the axis, more than 0.4 m apart.
+  const Vector2d dir = n.axis->direction();
+  const auto left_of_walk = [&](const graph::Lamp* l) {
+    const Vector2d d = l->xyz.head<2>() - n.axis->first;
+    return (from_first ? 1 : -1) * (dir.x() * d.y() - dir.y() * d.x());
+  };
+  std::vector<double> offsets;
+  for (const graph::Lamp* l : order) offsets.push_back(left_of_walk(l));
+  std::sort(offsets.begin(), offsets.end(), std::greater<>());
+  std::vector<double> starts = {offsets.empty() ? 0.0 : offsets.front()};  // each row's leftmost
+  // offset, rows from the left
+  for (std::size_t i = 1; i < offsets.size(); ++i)
+    if (offsets[i - 1] - offsets[i] > 0.4) starts.push_back(offsets[i]);
+  const auto row_of = [&](const graph::Lamp* l) {
+    const double a = left_of_walk(l);
+    std::size_t r = 0;
+    while (r + 1 < starts.size() && a <= starts[r + 1]) ++r;
+    return r;
+  };
+  std::string row;
+  if (starts.size() == 2)
+    row = row_of(lamp) == 0 ? " of the left row" : " of the right row";
+  else if (starts.size() > 2)
+    row = " of row " + std::to_string(row_of(lamp) + 1) + " of " + std::to_string(starts.size()) +
+          " from the left";
+  int in_row = 0;
+  for (const graph::Lamp* l : order) {
+    if (starts.size() > 1 && row_of(l) != row_of(lamp)) continue;
+    ++in_row;
+    if (l->id == lamp->id)
+      return n.name + ", " + graph::ordinal_number(in_row) + " lamp" + row + " from " + from;
+  }
   return n.name;
 }
 

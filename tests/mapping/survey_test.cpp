@@ -85,6 +85,34 @@ TEST(Survey, FindsTheFailedMovedAndNewLampsAndNothingElse) {
   EXPECT_NEAR(s.drive_scale, 1.0, 1e-3);
 }
 
+// A corridor of two rows: facility staff are told which row, left or right as they walk from the
+// place named, and the lamp's place in that row ("the 7th lamp" counting both rows would send
+// them to the wrong one). C1 runs from E1 to J1; its lamps 2 (a: north) and 7 (b: south) failed.
+TEST(Survey, SaysWhichRowOfACorridorOfTwoRows) {
+  const graph::TopologicalMap map =
+      test::edited(graph::read_map(test::source_path("maps/office_floor.geojson")).map,
+                   [](graph::Node& n) { test::two_rows(n, 0.6); });
+  const RobotDescription robot =
+      read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  sim::LampSensorOptions so;
+  so.failed_lamps = {"C1-L2a", "C1-L7b"};
+  const sim::LampSensors sensors(map, robot, so);
+  const test::DriveRecord drive =
+      test::drive_through({{1, 10}, {21, 10}}, 0.0, sensors, robot.semi_axis);
+  SurveyOptions o;
+  o.start = drive.start;  // a drive along one corridor fits each of its lamps alike
+  const SurveyResult s = survey(map, test::map_drive(drive, robot), robot, o);
+  std::map<std::string, std::string> where;
+  for (const auto& f : s.findings) {
+    std::cout << to_string(f.status) << " " << f.lamp << " (" << f.where << ")\n";
+    where[f.lamp] = f.where;
+  }
+  const std::map<std::string, std::string> want = {
+      {"C1-L2a", "C1, 2nd lamp of the left row from E1"},   // walking east: north is left
+      {"C1-L7b", "C1, 2nd lamp of the left row from J1"}};  // walking west: south is left
+  EXPECT_EQ(where, want);
+}
+
 // Wheels that read 1 % long (not calibrated): the drive's lamps 40 m from where the survey
 // anchors them are 40 cm off, and before the drive was scaled to the map, 16 of the 27 lamps of
 // a drive E1 -> K2 were reported moved. The map holds the scale: the same six changes and
