@@ -12,14 +12,21 @@ using Eigen::Vector2d;
 
 namespace {
 
-// How far apart across a corridor its lamps stand, from the lamps the drive passed under: half
-// the spread (10th to 90th percentile) of their offsets from each run's line, within
-// `rows_reach_m` of it and along it, the median over runs of at least 4 such lamps. Near 0 where a
-// corridor has one row (the robot drives under it, weaving a little); half the rows' spacing where
-// it has two (a wide corridor's two rows of troffers). The offsets are signed, so a drive along one
-// side of the corridor measures the same.
-double rows_half_spread(const std::vector<Line>& lines, const std::vector<Run>& runs,
-                        const std::vector<MappedLamp>& lamps, const TopologyOptions& o) {
+// Where a corridor's lamps stand across it, from the lamps the drive passed under: their signed
+// offsets from each run's line (left positive), within `rows_reach_m` of it and along it, for
+// runs of at least 4 such lamps. `centre`, per run: the middle of their spread (10th to 90th
+// percentile), 0 for a run of fewer lamps; near 0 where the robot drives under a row, 0.7 m where
+// the lamps hang to one side of the corridor and the robot drives down its middle.
+// `half_spread`: half that spread, the median over runs; near 0 for one row (the robot weaves a
+// little), half the rows' spacing for two (a wide corridor's two rows of troffers).
+struct RowsAcross {
+  double half_spread = 0;
+  std::vector<double> centre;
+};
+
+RowsAcross rows_across(const std::vector<Line>& lines, const std::vector<Run>& runs,
+                       const std::vector<MappedLamp>& lamps, const TopologyOptions& o) {
+  RowsAcross out;
   std::vector<double> halves, offsets;
   for (const auto& r : runs) {
     const Line& L = lines[r.line];
@@ -29,12 +36,15 @@ double rows_half_spread(const std::vector<Line>& lines, const std::vector<Run>& 
       const double s = L.along(p), across = d.x() * L.dir.y() - d.y() * L.dir.x();
       if (s >= r.s0 && s <= r.s1 && std::abs(across) <= o.rows_reach_m) offsets.push_back(across);
     }
+    out.centre.push_back(0);
     if (offsets.size() < 4) continue;
     std::sort(offsets.begin(), offsets.end());
     const std::size_t n = offsets.size() - 1, lo = n / 10, hi = n - n / 10;
     halves.push_back((offsets[hi] - offsets[lo]) / 2);
+    out.centre.back() = (offsets[hi] + offsets[lo]) / 2;
   }
-  return halves.empty() ? 0.0 : median(halves);
+  out.half_spread = halves.empty() ? 0.0 : median(halves);
+  return out;
 }
 
 }  // namespace
@@ -47,17 +57,20 @@ std::vector<SeenWay> ways_not_driven(const std::vector<Line>& lines, const std::
   // Corridors of two rows (or more): a way's lamps stand in a band as wide as the driven
   // corridors' rows, not on one line; the omni camera sees a far pair of lamps side by side as one
   // blob between them, a near pair as two. The band is 0 for one row (every figure as before).
-  const double half_spread = rows_half_spread(lines, runs, lamps, o);
-  const double band = half_spread > o.way_across_m ? half_spread : 0.0;
+  const RowsAcross rows = rows_across(lines, runs, lamps, o);
+  const double band = rows.half_spread > o.way_across_m ? rows.half_spread : 0.0;
   const double across = o.way_across_m + band;
+  // A run's own lamps: near the middle of its lamps' band, along it.
   std::vector<Vector2d> around;
   for (const Vector2d& p : seen) {
     bool own = false;
-    for (const auto& r : runs) {
+    for (std::size_t k = 0; k < runs.size(); ++k) {
+      const Run& r = runs[k];
       const Line& L = lines[r.line];
-      const double s = L.along(p);
+      const Vector2d d = p - L.origin;
+      const double s = L.along(p), off = d.x() * L.dir.y() - d.y() * L.dir.x() - rows.centre[k];
       own = own ||
-            (L.across(p) < o.same_line_m + band && s > r.s0 - o.place_m && s < r.s1 + o.place_m);
+            (std::abs(off) < o.same_line_m + band && s > r.s0 - o.place_m && s < r.s1 + o.place_m);
     }
     if (!own) around.push_back(p);
   }

@@ -389,13 +389,10 @@ TEST(Topology, WaysOutTheOmniCameraSawGivePlacesTheirTrueKind) {
   }
 }
 
-// The same drives on the office with two rows of lamps in every corridor, 1.2 m apart (a wide
-// corridor's troffers). Rows side by side are a room's grid to the ways' test; the driven
-// corridors' lamps say how far apart a corridor's rows stand, and the ways out are bands that
-// wide. Before, every way out was taken for a room's grid: no place of its true kind but the ends.
-TEST(Topology, WaysOutOfCorridorsOfTwoRows) {
+// The drives above on the office with its lamps hung by `hang`: every place of its true kind.
+void ways_out_of_the_office_as_hung(const std::function<void(graph::Node&)>& hang) {
   test::Office office;
-  office.map = test::edited(office.map, [](graph::Node& n) { test::two_rows(n, 0.6); });
+  office.map = test::edited(office.map, hang);
   test::DriveOptions o;
   o.omni_rate = 3;
   const std::vector<std::pair<std::string, std::vector<Vector2d>>> drives = {
@@ -417,6 +414,22 @@ TEST(Topology, WaysOutOfCorridorsOfTwoRows) {
     const graph::TopologicalMap driven = build_topology(mapped, {}, {}, &alone);
     EXPECT_FALSE(places_of_another_kind(driven, office.map, drive.start).empty());
   }
+}
+
+// Two rows of lamps in every corridor, 1.2 m apart (a wide corridor's troffers). Rows side by side
+// are a room's grid to the ways' test; the driven corridors' lamps say how far apart a corridor's
+// rows stand, and the ways out are bands that wide. Before, every way out was taken for a room's
+// grid: no place of its true kind but the ends.
+TEST(Topology, WaysOutOfCorridorsOfTwoRows) {
+  ways_out_of_the_office_as_hung([](graph::Node& n) { test::two_rows(n, 0.6); });
+}
+
+// The office's corridor lamps in one row 0.7 m to one side of the corridor, the robot down its
+// middle: a run's own lamps are those about the middle of its lamps' band, not of its line.
+// Before, the driven corridor's lamps near a junction stood beside every row down a way (a room's
+// grid to the ways' test): J1 and J2 came out corners.
+TEST(Topology, WaysOutOfCorridorsWhoseLampsHangToOneSide) {
+  ways_out_of_the_office_as_hung([](graph::Node& n) { test::to_one_side(n, 0.7); });
 }
 
 // A drive down every corridor of a generated building with its omni views: no way out is seen

@@ -65,4 +65,12 @@ inline void two_rows(graph::Node& n, double offset) {
   n.lamps = rows;
 }
 
+// A corridor's lamps hung `offset` m to the left of its axis (walking it from its first end), as
+// where a row of lamps runs along one side of a corridor and the robot drives down its middle.
+inline void to_one_side(graph::Node& n, double offset) {
+  if (n.place != graph::Place::corridor || !n.axis) return;
+  const Eigen::Vector2d along = n.axis->direction();
+  for (graph::Lamp& l : n.lamps) l.xyz.head<2>() += offset * Eigen::Vector2d(-along.y(), along.x());
+}
+
 }  // namespace lampnav::test
