@@ -1,8 +1,8 @@
 #include "lampnav/mapping/survey.hpp"
 
 #include <algorithm>
-#include <functional>
 #include <cmath>
+#include <functional>
 #include <map>
 #include <optional>
 
@@ -86,37 +86,46 @@ std::string describe(const graph::TopologicalMap& map, const graph::Node& n, con
   const auto order = map.lamps_in_walking_order(
       n.id, from_first ? graph::Travel::forward : graph::Travel::backward);
   // A corridor of two rows (or more): the lamp's row, left or right walking from `from`, and its
-  // place in that row. Rows are the lamps' offsets across the axis, more than 0.4 m apart.
+  // place in that row. Rows are groups of at least two lamps whose offsets across the axis are
+  // more than 0.4 m from the next group's; a lamp alone off the row (a crossing corridor's first,
+  // in the region) makes no row, and is counted in walking order among all.
   const Vector2d dir = n.axis->direction();
   const auto left_of_walk = [&](const graph::Lamp* l) {
     const Vector2d d = l->xyz.head<2>() - n.axis->first;
     return (from_first ? 1 : -1) * (dir.x() * d.y() - dir.y() * d.x());
   };
-  std::vector<double> offsets;
-  for (const graph::Lamp* l : order) offsets.push_back(left_of_walk(l));
-  std::sort(offsets.begin(), offsets.end(), std::greater<>());
-  std::vector<double> starts = {offsets.empty() ? 0.0 : offsets.front()};  // each row's leftmost
-  // offset, rows from the left
-  for (std::size_t i = 1; i < offsets.size(); ++i)
-    if (offsets[i - 1] - offsets[i] > 0.4) starts.push_back(offsets[i]);
+  std::vector<std::pair<double, const graph::Lamp*>> across;  // from the left
+  for (const graph::Lamp* l : order) across.emplace_back(left_of_walk(l), l);
+  std::sort(across.begin(), across.end(),
+            [](const auto& x, const auto& y) { return x.first > y.first; });
+  std::map<const graph::Lamp*, int> group;
+  std::vector<int> size;
+  for (std::size_t i = 0; i < across.size(); ++i) {
+    if (i == 0 || across[i - 1].first - across[i].first > 0.4) size.push_back(0);
+    group[across[i].second] = static_cast<int>(size.size()) - 1;
+    ++size.back();
+  }
+  std::map<int, int> row_of_group;  // groups of two lamps or more, numbered from the left
+  for (std::size_t g = 0; g < size.size(); ++g)
+    if (size[g] >= 2) row_of_group.emplace(static_cast<int>(g), int(row_of_group.size()));
+  const int rows = static_cast<int>(row_of_group.size());
   const auto row_of = [&](const graph::Lamp* l) {
-    const double a = left_of_walk(l);
-    std::size_t r = 0;
-    while (r + 1 < starts.size() && a <= starts[r + 1]) ++r;
-    return r;
+    const auto it = row_of_group.find(group.at(l));
+    return it == row_of_group.end() ? -1 : it->second;
   };
-  std::string row;
-  if (starts.size() == 2)
-    row = row_of(lamp) == 0 ? " of the left row" : " of the right row";
-  else if (starts.size() > 2)
-    row = " of row " + std::to_string(row_of(lamp) + 1) + " of " + std::to_string(starts.size()) +
-          " from the left";
-  int in_row = 0;
+  const int row = rows > 1 ? row_of(lamp) : -1;
+  std::string in_words;
+  if (row >= 0 && rows == 2)
+    in_words = row == 0 ? " of the left row" : " of the right row";
+  else if (row >= 0)
+    in_words =
+        " of row " + std::to_string(row + 1) + " of " + std::to_string(rows) + " from the left";
+  int k = 0;
   for (const graph::Lamp* l : order) {
-    if (starts.size() > 1 && row_of(l) != row_of(lamp)) continue;
-    ++in_row;
+    if (row >= 0 && row_of(l) != row) continue;
+    ++k;
     if (l->id == lamp->id)
-      return n.name + ", " + graph::ordinal_number(in_row) + " lamp" + row + " from " + from;
+      return n.name + ", " + graph::ordinal_number(k) + " lamp" + in_words + " from " + from;
   }
   return n.name;
 }

@@ -113,6 +113,32 @@ TEST(Survey, SaysWhichRowOfACorridorOfTwoRows) {
   EXPECT_EQ(where, want);
 }
 
+// One lamp beside a corridor's row (an exit sign's light, a crossing corridor's first lamp in the
+// region) makes no second row: the row's lamps keep their plain order.
+TEST(Survey, ALampAloneBesideTheRowMakesNoSecondRow) {
+  const graph::TopologicalMap map = test::edited(
+      graph::read_map(test::source_path("maps/office_floor.geojson")).map, [](graph::Node& n) {
+        if (n.name != "C1") return;
+        graph::Lamp beside = n.lamps[4];
+        beside.id = LampId("C1-BESIDE");
+        beside.xyz.y() += 0.9;
+        n.lamps.insert(n.lamps.begin() + 5, beside);
+      });
+  const RobotDescription robot =
+      read_robot_description(test::source_path("maps/robots/pioneer.json"));
+  sim::LampSensorOptions so;
+  so.failed_lamps = {"C1-L3"};
+  const sim::LampSensors sensors(map, robot, so);
+  const test::DriveRecord drive =
+      test::drive_through({{1, 10}, {21, 10}}, 0.0, sensors, robot.semi_axis);
+  SurveyOptions o;
+  o.start = drive.start;
+  const SurveyResult s = survey(map, test::map_drive(drive, robot), robot, o);
+  ASSERT_EQ(s.findings.size(), 1u);
+  EXPECT_EQ(s.findings[0].lamp, "C1-L3");
+  EXPECT_EQ(s.findings[0].where, "C1, 3rd lamp from E1");
+}
+
 // Wheels that read 1 % long (not calibrated): the drive's lamps 40 m from where the survey
 // anchors them are 40 cm off, and before the drive was scaled to the map, 16 of the 27 lamps of
 // a drive E1 -> K2 were reported moved. The map holds the scale: the same six changes and
