@@ -355,12 +355,14 @@ std::vector<Vector2d> seen_around(const test::DriveRecord& drive, const MappingR
 }
 
 // Office drives that pass junctions straight through or turn at them, and start or stop at a
-// corner, without going down the ways beside them. By the drive alone, a junction passed straight
-// through is no place (the corridor runs through it), one turned at is a corner, and a corner the
-// drive starts at is an end. The omni camera sees the lamps down the ways not taken: with them,
-// every place is of its true kind and linked as in the true map.
-TEST(Topology, WaysOutTheOmniCameraSawGivePlacesTheirTrueKind) {
-  const test::Office office;
+// corner, without going down the ways beside them, on the office with its lamps hung by `hang`.
+// By the drive alone, a junction passed straight through is no place (the corridor runs through
+// it), one turned at is a corner, and a corner the drive starts at is an end. The omni camera sees
+// the lamps down the ways not taken: with them, every place is of its true kind and linked as in
+// the true map.
+void ways_out_of_the_office_as_hung(const std::function<void(graph::Node&)>& hang) {
+  test::Office office;
+  office.map = test::edited(office.map, hang);
   test::DriveOptions o;
   o.omni_rate = 3;
   const std::vector<std::pair<std::string, std::vector<Vector2d>>> drives = {
@@ -389,31 +391,8 @@ TEST(Topology, WaysOutTheOmniCameraSawGivePlacesTheirTrueKind) {
   }
 }
 
-// The drives above on the office with its lamps hung by `hang`: every place of its true kind.
-void ways_out_of_the_office_as_hung(const std::function<void(graph::Node&)>& hang) {
-  test::Office office;
-  office.map = test::edited(office.map, hang);
-  test::DriveOptions o;
-  o.omni_rate = 3;
-  const std::vector<std::pair<std::string, std::vector<Vector2d>>> drives = {
-      {"E1 -> J1 -> J2 -> E2", {{1, 10}, {21, 10}, {21, -8}, {1, -8}}},
-      {"K1 -> J1 -> E1", {{41, 10}, {1, 10}}},
-      {"E1 -> J1 -> J2 -> K2", {{1, 10}, {21, 10}, {21, -8}, {41, -8}}},
-      {"E2 -> J2 -> K2 -> K1", {{1, -8}, {41, -8}, {41, 10}}},
-  };
-  for (const auto& [name, waypoints] : drives) {
-    SCOPED_TRACE(name);
-    const test::DriveRecord drive = office.drive(waypoints, o);
-    const MappingResult mapped = test::map_drive(drive, office.robot);
-    TopologyReport rep, alone;
-    const graph::TopologicalMap built =
-        build_topology(mapped, {}, {}, &rep, seen_around(drive, mapped, office.robot));
-    const auto wrong = places_of_another_kind(built, office.map, drive.start);
-    EXPECT_TRUE(wrong.empty()) << ::testing::PrintToString(wrong);
-    EXPECT_GE(rep.ways_seen, 1u);
-    const graph::TopologicalMap driven = build_topology(mapped, {}, {}, &alone);
-    EXPECT_FALSE(places_of_another_kind(driven, office.map, drive.start).empty());
-  }
+TEST(Topology, WaysOutTheOmniCameraSawGivePlacesTheirTrueKind) {
+  ways_out_of_the_office_as_hung([](graph::Node&) {});
 }
 
 // Two rows of lamps in every corridor, 1.2 m apart (a wide corridor's troffers). Rows side by side
