@@ -56,7 +56,7 @@ std::vector<SeenWay> ways_not_driven(const std::vector<Line>& lines, const std::
   if (o.way_min_lamps == 0 || seen.empty()) return out;
   // Corridors of two rows (or more): a way's lamps stand in a band as wide as the driven
   // corridors' rows, not on one line; the omni camera sees a far pair of lamps side by side as one
-  // blob between them, a near pair as two. The band is 0 for one row (every figure as before).
+  // blob between them, a near pair as two. The band is 0 for one row.
   const RowsAcross rows = rows_across(lines, runs, lamps, o);
   const double band = rows.half_spread > o.way_across_m ? rows.half_spread : 0.0;
   const double across = o.way_across_m + band;

@@ -58,11 +58,12 @@ struct TopologyOptions {
   // such row going the same way within way_beside_m of it and at most one lamp off its line
   // within way_clear_m of it (rows side by side, and diagonals, are a room's or a hall's grid of
   // lamps; one lamp beside is a room's, seen through its door).
-  // Lamps within same_line_m of a run's line, along the run, are its own.
-  // Corridors of two or more rows: the lamps the drive passed under within rows_reach_m across a
-  // run tell how far apart its rows are (half their spread across it, the median over runs). When
-  // that is more than way_across_m, it widens the rows of ways (each lamp within way_across_m plus
-  // it of the row's line), the runs' own lamps, and the lamps beside a row that are not its own.
+  // The lamps the drive passed under within rows_reach_m across a run tell where its lamps hang
+  // across it (the middle of their spread: under the drive, or to one side) and how far apart its
+  // rows are (half their spread, the median over runs: 0 for one row). Lamps within same_line_m
+  // of that middle, along the run, are its own. When the half spread is more than way_across_m (two
+  // rows or more), it widens the rows of ways (each lamp within way_across_m plus it of the row's
+  // line), the runs' own lamps, and the lamps beside a row that are not its own.
   double rows_reach_m = 1.5;
   int way_min_lamps = 3;
   double way_across_m = 0.3;
