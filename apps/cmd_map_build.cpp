@@ -101,7 +101,8 @@ int run_build(const BuildArgs& a) {
   for (const auto& n : map.nodes()) ++by_place[n.place];
   std::cout << "map        " << a.out << "\n";
   std::cout << "drive      " << r.travel_m << " m, " << r.frames << " ceiling frames, "
-            << r.lamps_seen_whole << " lamps seen whole\n";
+            << r.lamps_seen_whole << " lamps seen whole, " << r.lamps_seen_cut
+            << " cut by the border\n";
   std::cout << "lamps      " << map.lamp_count() << " mapped (" << r.mapped.revisits
             << " sightings after a loop; " << r.mapped.merged << " merged, " << r.mapped.dropped
             << " seen too few times); reprojection RMS " << r.mapped.final_rms_px << " px\n";

@@ -51,6 +51,22 @@ TEST(MapBuilder, EveryFrameDarkIsAFailureNotAnEmptyMap) {
   }
 }
 
+// Lamps only ever at the edge of the view, cut by the border (a wide corridor's two rows, the robot
+// down the middle between them): the failure says why, and how to drive.
+TEST(MapBuilder, LampsOnlyEverCutByTheBorderSayHowToDrive) {
+  Image8 img(352, 288, 20);
+  for (int y = 0; y < 19; ++y)  // a 150 x 38 px lamp across the top edge, half of it in view
+    for (int x = 101; x < 251; ++x) img.at(x, y) = 240;
+  try {
+    build_map(log_of(img, 20, 0.5), "beside.mcap", robot(), {}, {});
+    FAIL() << "built a map from lamps never seen whole";
+  } catch (const JobFailed& e) {
+    EXPECT_THAT(std::string(e.what()), HasSubstr("beside.mcap"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("only lamps cut by the image's border"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("drive under a row of lamps"));
+  }
+}
+
 TEST(MapBuilder, ARobotThatNeverMovesIsAFailure) {
   const io::MissionLog log = log_of(frame_with_a_lamp(), 20, 0.0);
   try {

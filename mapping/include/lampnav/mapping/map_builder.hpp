@@ -68,6 +68,7 @@ struct DriveLamps {
   std::vector<vision::LampShapePrior> kinds;
   vision::LampShapePrior prior;
   std::size_t frames = 0, unreadable_frames = 0, lamps_seen_whole = 0;
+  std::size_t lamps_seen_cut = 0;  // sightings of lamps cut by the image's border
   double travel_m = 0;
   // The map's frame is the drive's start; false: where the robot was put down after a carry (the
   // drive before it is left out).
