@@ -598,7 +598,8 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
   for (const auto& [a, b] : node_links) link(nodes[a], nodes[b]);
   if (rep.lamps_outside)
     rep.notes.push_back(std::to_string(rep.lamps_outside) +
-                        " lamps lie in no corridor, place or hall the drive went through "
+                        (rep.lamps_outside == 1 ? " lamp lies" : " lamps lie") +
+                        " in no corridor, place or hall the drive went through "
                         "(rooms, halls seen from one lane): left out");
   if (report) *report = rep;
   return map;
