@@ -25,6 +25,10 @@ namespace lampnav::mapping {
 
 namespace {
 
+// The advice when the ceiling camera saw the lamps only at the border of its view.
+const std::string kDriveUnderARow =
+    "drive under a row of lamps (in a wide corridor, along one of its rows)";
+
 // Where a measured distance came from, for messages: the user's flag, or its place in the options.
 ErrorContext where_given(const KnownDistance& d, std::size_t k) {
   return {"", d.given_as.empty() ? "distances[" + std::to_string(k) + "]" : d.given_as, ""};
@@ -435,8 +439,8 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
       throw JobFailed(source + ": no lamp was seen whole in " + std::to_string(frames.size()) +
                       " ceiling frames, only lamps cut by the image's border (" +
                       std::to_string(cut) + " in " + std::to_string(probed) +
-                      " frames looked at): the camera passed beside the lamps, not under them; "
-                      "drive under a row of lamps (in a wide corridor, along one of its rows)");
+                      " frames looked at): the camera passed beside the lamps, not under them; " +
+                      kDriveUnderARow);
     if (looks.empty())
       throw JobFailed(source + ": no lamp was seen whole in " + std::to_string(frames.size()) +
                       " ceiling frames: there is nothing to map");
@@ -559,8 +563,7 @@ DriveLamps map_drive_lamps(const io::MissionLog& log, const std::string& source,
     out.notes.push_back("most lamps were seen cut by the image's border (" +
                         std::to_string(out.lamps_seen_cut) + " sightings, " +
                         std::to_string(out.lamps_seen_whole) + " whole): the camera passed " +
-                        "beside the lamps, not under them, and " + buf +
-                        "; drive under a row of lamps (in a wide corridor, along one of its rows)");
+                        "beside the lamps, not under them, and " + buf + "; " + kDriveUnderARow);
   }
   return out;
 }

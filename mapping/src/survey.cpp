@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <map>
 #include <optional>
 
@@ -98,22 +97,14 @@ std::string describe(const graph::TopologicalMap& map, const graph::Node& n, con
   for (const graph::Lamp* l : order) across.emplace_back(left_of_walk(l), l);
   std::sort(across.begin(), across.end(),
             [](const auto& x, const auto& y) { return x.first > y.first; });
-  std::map<const graph::Lamp*, int> group;
-  std::vector<int> size;
-  for (std::size_t i = 0; i < across.size(); ++i) {
-    if (i == 0 || across[i - 1].first - across[i].first > 0.4) size.push_back(0);
-    group[across[i].second] = static_cast<int>(size.size()) - 1;
-    ++size.back();
+  std::map<const graph::Lamp*, int> row_of;  // rows numbered from the left; -1: a lamp alone
+  int rows = 0;
+  for (std::size_t i = 0, j; i < across.size(); i = j) {
+    for (j = i + 1; j < across.size() && across[j - 1].first - across[j].first <= 0.4;) ++j;
+    const int r = j - i >= 2 ? rows++ : -1;
+    for (std::size_t k = i; k < j; ++k) row_of[across[k].second] = r;
   }
-  std::map<int, int> row_of_group;  // groups of two lamps or more, numbered from the left
-  for (std::size_t g = 0; g < size.size(); ++g)
-    if (size[g] >= 2) row_of_group.emplace(static_cast<int>(g), int(row_of_group.size()));
-  const int rows = static_cast<int>(row_of_group.size());
-  const auto row_of = [&](const graph::Lamp* l) {
-    const auto it = row_of_group.find(group.at(l));
-    return it == row_of_group.end() ? -1 : it->second;
-  };
-  const int row = rows > 1 ? row_of(lamp) : -1;
+  const int row = rows > 1 ? row_of.at(lamp) : -1;
   std::string in_words;
   if (row >= 0 && rows == 2)
     in_words = row == 0 ? " of the left row" : " of the right row";
@@ -122,7 +113,7 @@ std::string describe(const graph::TopologicalMap& map, const graph::Node& n, con
         " of row " + std::to_string(row + 1) + " of " + std::to_string(rows) + " from the left";
   int k = 0;
   for (const graph::Lamp* l : order) {
-    if (row >= 0 && row_of(l) != row) continue;
+    if (row >= 0 && row_of.at(l) != row) continue;
     ++k;
     if (l->id == lamp->id)
       return n.name + ", " + graph::ordinal_number(k) + " lamp" + in_words + " from " + from;

@@ -8,7 +8,6 @@
 #include "halls.hpp"
 #include "lampnav/core/error.hpp"
 #include "lampnav/graph/geojson.hpp"
-#include "omni_ways.hpp"
 #include "seen_ways.hpp"
 
 namespace lampnav::mapping {

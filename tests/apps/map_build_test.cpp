@@ -10,6 +10,7 @@
 #include <set>
 
 #include "cli_support.hpp"
+#include "edited_map.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/mapping/rigid_fit.hpp"
@@ -531,36 +532,15 @@ TEST(MapBuild, LampsEightMetresUpAreMappedAsWell) {
 // rows side by side were a room's grid: both junctions came out corners; without taking the askew
 // rows of one way as one, the drive had a junction in the middle of C5.
 TEST(MapBuild, CorridorsOfTwoRowsKeepTheirWaysOut) {
-  nlohmann::json doc =
-      nlohmann::json::parse(test::slurp(test::source_path("maps/office_floor.geojson")));
-  for (auto& f : doc["features"]) {
-    const auto& md = f["properties"]["metadata"];
-    if (!f["properties"].contains("lampnav") || !md.contains("place") || md["place"] == "room" ||
-        md["place"] == "door")
-      continue;
-    Eigen::Vector2d along(1, 0);
-    if (md.contains("axis"))
-      along = Eigen::Vector2d(
-                  md["axis"]["x_values"][1].get<double>() - md["axis"]["x_values"][0].get<double>(),
-                  md["axis"]["y_values"][1].get<double>() - md["axis"]["y_values"][0].get<double>())
-                  .normalized();
-    nlohmann::json rows = nlohmann::json::array();
-    for (const auto& l : f["properties"]["lampnav"]["lamps"])
-      for (const double side : {0.75, -0.75}) {
-        auto c = l;
-        c["id"] = l["id"].get<std::string>() + (side > 0 ? "a" : "b");
-        c["xyz"][0] = l["xyz"][0].get<double>() - side * along.y();
-        c["xyz"][1] = l["xyz"][1].get<double>() + side * along.x();
-        rows.push_back(c);
-      }
-    f["properties"]["lampnav"]["lamps"] = rows;
-  }
+  const graph::TopologicalMap rows =
+      test::edited(graph::read_map(test::source_path("maps/office_floor.geojson")).map,
+                   [](graph::Node& n) { test::two_rows(n, 0.75); });
   const fs::path dir =
       fs::temp_directory_path() / ("lampnav_two_rows_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const std::string map = (dir / "two_rows.geojson").string(), log = (dir / "drive.mcap").string(),
                     out = (dir / "built.geojson").string();
-  std::ofstream(map) << doc.dump();
+  std::ofstream(map) << graph::write_map(rows);
   const auto sim =
       test::run_lampnav("sim --route 'E1 -> E2' --seed 5 --map '" + map + "' --robot " +
                         test::quoted_source("maps/robots/pioneer.json") + " -q -o '" + log + "'");

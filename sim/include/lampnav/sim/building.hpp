@@ -2,11 +2,10 @@
 // Generated buildings for the scale benchmarks and the localization batteries: a square grid of
 // junctions (corners at the grid's corners) joined by corridors, with rooms and their doors off
 // the corridors, lamps along every corridor (in one row or two), over every junction and in every
-// room. With every
-// asymmetry off (no rooms, no missing corridor, one spacing, no lobby) the grid is perfectly
-// symmetric: a quarter turn maps it onto itself. The asymmetries real buildings have can be
-// switched on: a missing corridor, a wing with another lamp spacing, a lobby. The same options
-// and seed give the same map.
+// room. With every asymmetry off (no rooms, no missing corridor, one spacing, no lobby) the grid
+// is perfectly symmetric: a quarter turn maps it onto itself. The asymmetries real buildings have
+// can be switched on: a missing corridor, a wing with another lamp spacing, a lobby. The same
+// options and seed give the same map.
 
 #include <cstdint>
 #include <string>
