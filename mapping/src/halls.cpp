@@ -58,7 +58,72 @@ std::pair<double, double> inside(const Line& L, const graph::Polygon& P) {
   return {lo, hi};
 }
 
+// The rows of lamps across a lane, from their offsets across it (sorted): clusters of two lamps
+// or more whose gaps are under 0.3 m (a corridor crossing the lanes has one lamp in each lane),
+// each as its first and last offset.
+std::vector<std::pair<double, double>> rows_of(const std::vector<double>& off) {
+  std::vector<std::pair<double, double>> rows;
+  for (std::size_t i = 0, j = 0; i < off.size(); i = j) {
+    for (j = i + 1; j < off.size() && off[j] - off[j - 1] < 0.3;) ++j;
+    if (j - i >= 2) rows.emplace_back(off[i], off[j - 1]);
+  }
+  return rows;
+}
+
 }  // namespace
+
+int join_lanes_under_two_rows(std::vector<Line>& lines, const std::vector<MappedLamp>& lamps,
+                              const TopologyOptions& o) {
+  const double parallel = std::sin(o.parallel_deg * M_PI / 180);
+  int joined = 0;
+  for (std::size_t i = 0; i < lines.size(); ++i)
+    for (std::size_t j = i + 1; j < lines.size(); ++j) {
+      Line &A = lines[i], &B = lines[j];
+      if (std::abs(A.dir.x() * B.dir.y() - A.dir.y() * B.dir.x()) > parallel) continue;
+      const double gap = A.across(B.origin);
+      if (gap <= o.same_line_m || gap > o.row_beside_m) continue;
+      // Where both were driven side by side, along A.
+      double lo = 1e300, hi = -1e300, overlap = 0;
+      for (const auto& [a0, a1] : A.intervals)
+        for (const auto& [b0, b1] : B.intervals) {
+          const double p = A.along(B.at(b0)), q = A.along(B.at(b1));
+          const double l = std::max(a0, std::min(p, q)), h = std::min(a1, std::max(p, q));
+          if (h - l <= 0) continue;
+          overlap += h - l;
+          lo = std::min(lo, l);
+          hi = std::max(hi, h);
+        }
+      if (overlap < o.hall_min_overlap_m) continue;
+      // The mapped lamps there, within row_beside_m outside either lane, by their offset from A
+      // towards B: a hall driven in lanes has more rows of lamps beside them.
+      const Vector2d n = Vector2d(-A.dir.y(), A.dir.x()) *
+                         ((B.origin - A.origin).dot(Vector2d(-A.dir.y(), A.dir.x())) < 0 ? -1 : 1);
+      std::vector<double> off;
+      for (const MappedLamp& l : lamps) {
+        const Vector2d p = l.xyz.head<2>();
+        const double s = A.along(p), t = n.dot(p - A.origin);
+        if (s >= lo && s <= hi && t > -o.row_beside_m && t < gap + o.row_beside_m) off.push_back(t);
+      }
+      std::sort(off.begin(), off.end());
+      const auto rows = rows_of(off);
+      const auto middle = [&](std::size_t k) { return 0.5 * (rows[k].first + rows[k].second); };
+      if (rows.size() != 2 || std::abs(middle(0)) > o.same_line_m ||
+          std::abs(middle(1) - gap) > o.same_line_m)
+        continue;
+      // One line half way between, with both lines' stretches.
+      Line mid{A.origin + 0.5 * gap * n, A.dir, {}};
+      for (const Line* L : {&A, &B})
+        for (const auto& [s0, s1] : L->intervals) {
+          const double p = mid.along(L->at(s0)), q = mid.along(L->at(s1));
+          mid.intervals.emplace_back(std::min(p, q), std::max(p, q));
+        }
+      A = mid;
+      lines.erase(lines.begin() + static_cast<std::ptrdiff_t>(j));
+      --j;
+      ++joined;
+    }
+  return joined;
+}
 
 // Lanes are pieces of runs of two different lines, parallel, side by side over more than
 // hall_min_overlap_m, further apart than same_line_m and at most hall_lane_gap_m. A hall's region
@@ -116,14 +181,9 @@ std::vector<graph::Polygon> halls_from_lanes(const std::vector<Line>& lines,
       off.push_back(across.dot(p));
     }
     std::sort(off.begin(), off.end());
-    double lo = 1e300, hi = -1e300;
-    for (std::size_t i = 0, j = 0; i < off.size(); i = j) {
-      for (j = i + 1; j < off.size() && off[j] - off[j - 1] < 0.3;) ++j;
-      if (j - i < 2) continue;
-      lo = std::min(lo, off[i]);
-      hi = std::max(hi, off[j - 1]);
-    }
-    if (hi - lo >= o.hall_min_spread_m) kept.push_back(std::move(pts));
+    const auto rows = rows_of(off);
+    if (!rows.empty() && rows.back().second - rows.front().first >= o.hall_min_spread_m)
+      kept.push_back(std::move(pts));
   }
   for (const auto& pts : kept) halls.push_back(grown_hull(pts, o.hall_margin_m));
   return halls;

@@ -33,6 +33,15 @@ struct Run {
   int hall0 = -1, hall1 = -1;  // the hall an end stops at (the run went on through it)
 };
 
+// A wide corridor of two rows of lamps driven as docs/mapping.md asks, up one row and back along
+// the other: two parallel lines, side by side (further apart than same_line_m, at most
+// row_beside_m) over more than hall_min_overlap_m, whose mapped lamps there (out to row_beside_m
+// beyond either) stand in exactly two rows, each line under one of them (within same_line_m). Such
+// lanes are one corridor, not a hall: the pair becomes one line half way between them, holding both
+// lines' stretches. Returns how many pairs were joined.
+int join_lanes_under_two_rows(std::vector<Line>& lines, const std::vector<MappedLamp>& lamps,
+                              const TopologyOptions& o);
+
 // Halls from lanes: the pieces of runs with another beside them, grouped where they touch; a
 // group is a hall when the lamps around it stand in rows along its lanes, spread across them.
 std::vector<graph::Polygon> halls_from_lanes(const std::vector<Line>& lines,

@@ -27,7 +27,7 @@ namespace {
 
 // The advice when the ceiling camera saw the lamps only at the border of its view.
 const std::string kDriveUnderARow =
-    "drive under a row of lamps (in a wide corridor, along one of its rows)";
+    "drive under the rows of lamps (in a wide corridor, up one row and back along the other)";
 
 // Where a measured distance came from, for messages: the user's flag, or its place in the options.
 ErrorContext where_given(const KnownDistance& d, std::size_t k) {

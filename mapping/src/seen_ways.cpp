@@ -12,8 +12,14 @@ using Eigen::Vector2d;
 
 namespace {
 
+// Signed offset of `p` across `L` (positive to the right of its direction).
+double signed_across(const Line& L, const Vector2d& p) {
+  const Vector2d d = p - L.origin;
+  return d.x() * L.dir.y() - d.y() * L.dir.x();
+}
+
 // Where a corridor's lamps stand across it, from the lamps the drive passed under: their signed
-// offsets from each run's line (left positive), within `rows_reach_m` of it and along it, for
+// offsets from each run's line (right positive), within `rows_reach_m` of it and along it, for
 // runs of at least 4 such lamps. `centre`, per run: the middle of their spread (10th to 90th
 // percentile), 0 for a run of fewer lamps; near 0 where the robot drives under a row, 0.7 m where
 // the lamps hang to one side of the corridor and the robot drives down its middle.
@@ -32,8 +38,8 @@ RowsAcross rows_across(const std::vector<Line>& lines, const std::vector<Run>& r
     const Line& L = lines[r.line];
     offsets.clear();
     for (const MappedLamp& l : lamps) {
-      const Vector2d p = l.xyz.head<2>(), d = p - L.origin;
-      const double s = L.along(p), across = d.x() * L.dir.y() - d.y() * L.dir.x();
+      const Vector2d p = l.xyz.head<2>();
+      const double s = L.along(p), across = signed_across(L, p);
       if (s >= r.s0 && s <= r.s1 && std::abs(across) <= o.rows_reach_m) offsets.push_back(across);
     }
     out.centre.push_back(0);
@@ -49,9 +55,79 @@ RowsAcross rows_across(const std::vector<Line>& lines, const std::vector<Run>& r
 
 }  // namespace
 
+std::vector<RowBeside> rows_beside(const std::vector<Line>& lines, const std::vector<Run>& runs,
+                                   const std::vector<MappedLamp>& lamps,
+                                   const std::vector<Vector2d>& seen, const TopologyOptions& o) {
+  // From the mapped row; between a row's lamps, across; between two lamps of a row, along.
+  constexpr double kClear = 0.5, kGap = 0.4, kSame = 1.0;
+  std::vector<RowBeside> out;
+  std::vector<double> offsets, along;
+  std::vector<std::pair<double, double>> near;  // seen beside: (offset, along)
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    const Run& r = runs[k];
+    const Line& L = lines[r.line];
+    offsets.clear();
+    along.clear();
+    for (const MappedLamp& l : lamps) {
+      const Vector2d p = l.xyz.head<2>();
+      const double s = L.along(p), across = signed_across(L, p);
+      if (s >= r.s0 && s <= r.s1 && std::abs(across) <= o.rows_reach_m) {
+        offsets.push_back(across);
+        along.push_back(s);
+      }
+    }
+    if (offsets.size() < 4) continue;
+    std::sort(offsets.begin(), offsets.end());
+    const std::size_t n = offsets.size() - 1;
+    const double lo = offsets[n / 10], hi = offsets[n - n / 10];
+    const auto [s0, s1] = std::minmax_element(along.begin(), along.end());
+    near.clear();
+    for (const Vector2d& p : seen) {
+      const double s = L.along(p), across = signed_across(L, p);
+      if (s >= *s0 && s <= *s1 && std::abs(across) <= o.row_beside_m &&
+          (across < lo - kClear || across > hi + kClear))
+        near.push_back({across, s});
+    }
+    std::sort(near.begin(), near.end());
+    // The mapped row's spacing; the other row's lamps are as close (a room's lamps beside a
+    // corridor, one a room, are further apart: the generated buildings' rooms, 2.4 m off the axis).
+    const double spacing = (*s1 - *s0) / double(offsets.size() - 1);
+    RowBeside best;
+    std::vector<double> at;
+    for (std::size_t a = 0, b = 0; a < near.size(); a = b) {
+      at = {near[a].second};
+      for (b = a + 1; b < near.size() && near[b].first - near[b - 1].first <= kGap; ++b)
+        at.push_back(near[b].second);
+      // Lamps, not sightings: the omni camera's lamps along the row more than kSame apart.
+      std::sort(at.begin(), at.end());
+      int count = 1;
+      for (std::size_t i = 1; i < at.size(); ++i) count += at[i] - at[i - 1] > kSame;
+      const double length = at.back() - at.front();
+      if (count < 4 || length < 0.5 * (*s1 - *s0) || length / (count - 1) > 1.5 * spacing ||
+          count <= best.lamps)
+        continue;
+      const double other = near[a + (b - a) / 2].first, mine = other > hi ? hi : lo;
+      const Vector2d right(L.dir.y(), -L.dir.x());
+      best.run = static_cast<int>(k);
+      best.middle = L.at(0.5 * (*s0 + *s1)) + 0.5 * (lo + hi) * right;
+      best.towards = other > hi ? right : Vector2d(-right);
+      best.offset = other;
+      best.apart_m = std::abs(other - mine);
+      best.s0 = at.front();
+      best.s1 = at.back();
+      best.length_m = length;
+      best.lamps = count;
+    }
+    if (best.lamps > 0) out.push_back(best);
+  }
+  return out;
+}
+
 std::vector<SeenWay> ways_not_driven(const std::vector<Line>& lines, const std::vector<Run>& runs,
                                      const std::vector<MappedLamp>& lamps,
-                                     const std::vector<Vector2d>& seen, const TopologyOptions& o) {
+                                     const std::vector<Vector2d>& seen,
+                                     const std::vector<RowBeside>& other_rows,
+                                     const TopologyOptions& o) {
   std::vector<SeenWay> out;
   if (o.way_min_lamps == 0 || seen.empty()) return out;
   // Corridors of two rows (or more): a way's lamps stand in a band as wide as the driven
@@ -67,13 +143,24 @@ std::vector<SeenWay> ways_not_driven(const std::vector<Line>& lines, const std::
     for (std::size_t k = 0; k < runs.size(); ++k) {
       const Run& r = runs[k];
       const Line& L = lines[r.line];
-      const Vector2d d = p - L.origin;
-      const double s = L.along(p), off = d.x() * L.dir.y() - d.y() * L.dir.x() - rows.centre[k];
-      own = own ||
-            (std::abs(off) < o.same_line_m + band && s > r.s0 - o.place_m && s < r.s1 + o.place_m);
+      const double s = L.along(p), across_run = signed_across(L, p);
+      const bool along = s > r.s0 - o.place_m && s < r.s1 + o.place_m;
+      own = own || (along && std::abs(across_run - rows.centre[k]) < o.same_line_m + band);
+    }
+    // The other row of a corridor driven under one of its two: its own too.
+    for (const RowBeside& b : other_rows) {
+      const Line& L = lines[runs[b.run].line];
+      const double s = L.along(p);
+      own = own || (s > b.s0 - 0.5 && s < b.s1 + 0.5 &&
+                    std::abs(signed_across(L, p) - b.offset) < o.same_line_m);
     }
     if (!own) around.push_back(p);
   }
+  // Corridors driven under one of their two rows: their ways out have two rows as well, as far
+  // apart as the rows beside the runs (the other row is no room's lamps beside a way).
+  std::vector<double> halves;
+  for (const RowBeside& b : other_rows) halves.push_back(b.apart_m / 2);
+  const double rows_band = std::max(band, halves.empty() ? 0.0 : median(halves));
   const double min_sin = std::sin(o.way_min_angle_deg * M_PI / 180);
   for (const LampRow& row : lamp_rows(around, o.way_min_lamps, across, o.way_gap_m)) {
     const Vector2d u = row.dir();
@@ -85,7 +172,7 @@ std::vector<SeenWay> ways_not_driven(const std::vector<Line>& lines, const std::
     for (const Vector2d& p : around) {
       const Vector2d e = p - row.first;
       const double off = std::abs(u.x() * e.y() - u.y() * e.x()), s = u.dot(e);
-      beside += off > 4 * o.way_across_m + 2 * band && off < o.way_clear_m && s > -o.way_clear_m &&
+      beside += off > 4 * o.way_across_m + 2 * rows_band && off < o.way_clear_m && s > -o.way_clear_m &&
                 s < length + o.way_clear_m;
     }
     if (beside > 1) continue;
@@ -118,7 +205,7 @@ std::vector<SeenWay> ways_not_driven(const std::vector<Line>& lines, const std::
     }
     if (!beside) alone.push_back(x);
   }
-  if (band == 0) return alone;
+  if (rows_band == 0) return alone;
   // In a band of rows, few lamps are seen down a way (a far pair is one blob), and lines through a
   // lamp of one row and the next of the other hold as many as the band's own: each way is found
   // several times, askew by up to 30 degrees, crossing the run up to 2 m from where it meets it.
@@ -148,8 +235,12 @@ std::vector<SeenWay> ways_not_driven(const std::vector<Line>& lines, const std::
     g->weight += x.lamps;
   }
   std::vector<SeenWay> kept;
-  for (const Group& g : groups)
-    kept.push_back({g.at / g.weight, g.way.normalized(), g.middle / g.weight, g.first.lamps});
+  for (const Group& g : groups) {
+    if (band > 0)
+      kept.push_back({g.at / g.weight, g.way.normalized(), g.middle / g.weight, g.first.lamps});
+    else  // the drive mapped one of the rows: the way with the most lamps
+      kept.push_back(g.first);
+  }
   return kept;
 }
 

@@ -44,9 +44,16 @@ void TopologyOptions::validate() const {
   check(way_min_angle_deg > 0 && way_min_angle_deg <= 90, "way_min_angle_deg",
         "must be 0 to 90 degrees");
   check(rows_reach_m >= 0, "rows_reach_m", "must not be negative");
+  check(row_beside_m >= 0, "row_beside_m", "must not be negative");
 }
 
 namespace {
+
+// A direction in the map's frame as users read it: whole degrees, 0 to 359.
+int heading_deg(const Vector2d& v) {
+  const long deg = std::lround(std::atan2(v.y(), v.x()) * 180 / M_PI);
+  return static_cast<int>((deg % 360 + 360) % 360);
+}
 
 using namespace drive_topology;
 
@@ -186,6 +193,8 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     const double sa = L.along(a), sb = L.along(b);
     L.intervals.emplace_back(std::min(sa, sb), std::max(sa, sb));
   }
+  // A wide corridor driven up one of its rows and back along the other is one corridor.
+  rep.lanes_joined = static_cast<std::size_t>(join_lanes_under_two_rows(lines, mapped.lamps, o));
   std::vector<Run> runs;
   for (std::size_t l = 0; l < lines.size(); ++l) {
     auto iv = lines[l].intervals;
@@ -245,7 +254,9 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     if (r.hall1 < 0) add_place(lines[r.line].at(r.s1));
   }
   // 2b. Ways out not driven, seen: where one meets a run is a place.
-  const std::vector<SeenWay> seen_ways = ways_not_driven(lines, runs, mapped.lamps, seen, o);
+  const std::vector<RowBeside> unmapped_rows = rows_beside(lines, runs, mapped.lamps, seen, o);
+  const std::vector<SeenWay> seen_ways =
+      ways_not_driven(lines, runs, mapped.lamps, seen, unmapped_rows, o);
   for (const SeenWay& x : seen_ways) add_place(x.at);
   // Ways out of each place: the runs that go on from it by more than a place's size.
   // Where a point lies along a run (the distance along its line), if the run passes it.
@@ -531,17 +542,29 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     if (q.seen.empty() || q.node < 0 || dropped[q.node]) continue;
     rep.ways_seen += q.seen.size();
     std::string headings;
-    for (const Vector2d& way : q.seen) {
-      const double deg = std::atan2(way.y(), way.x()) * 180 / M_PI;
-      headings += (headings.empty() ? "" : " and ") +
-                  std::to_string(static_cast<int>(std::lround(deg < 0 ? deg + 360 : deg)));
-    }
+    for (const Vector2d& way : q.seen)
+      headings += (headings.empty() ? "" : " and ") + std::to_string(heading_deg(way));
     rep.notes.push_back(nodes[q.node].name + " is a " + graph::to_string(q.kind) + " by " +
                         (q.seen.size() == 1 ? "a way" : "ways") +
                         " out the omni camera saw and the drive did not take (heading " + headings +
                         " degrees in the map's frame): drive " +
                         (q.seen.size() == 1 ? "it" : "them") + " to map " +
                         (q.seen.size() == 1 ? "its corridor" : "their corridors"));
+  }
+
+  // Rows beside the driven ones (a wide corridor's other row), seen and not mapped.
+  for (const RowBeside& b : unmapped_rows) {
+    std::string where = "the drive";
+    for (std::size_t i = 0; i < nodes.size(); ++i)
+      if (!dropped[i] && nodes[i].region.contains(b.middle, 0.5)) where = nodes[i].name;
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "the omni camera saw another row of lamps %.1f m beside %s, along %.0f m of it "
+                  "(towards heading %d degrees in the map's frame), that the map does not hold: "
+                  "the ceiling camera saw them only at its border; drive under that row too",
+                  b.apart_m, where.c_str(), b.length_m, heading_deg(b.towards));
+    rep.notes.push_back(buf);
+    ++rep.rows_beside;
   }
 
   // 5. Lamps into the place whose region holds them, in walking order.

@@ -15,74 +15,16 @@
 #include "lampnav/io/mission_log.hpp"
 #include "lampnav/mapping/rigid_fit.hpp"
 #include "lampnav_test.hpp"
+#include "map_build_support.hpp"
 
 namespace lampnav {
 namespace {
 
 using ::testing::HasSubstr;
 namespace fs = std::filesystem;
-
-struct Recorded {
-  fs::path dir = fs::temp_directory_path() / ("lampnav_map_build_" + std::to_string(::getpid()));
-  std::string log = (dir / "drive.mcap").string();
-  // The drive E1 -> K2 (unless `flags` give a --route) on `map` (the office floor's file unless
-  // given) by `robot` (the bundled one unless given), `sim` flags added.
-  explicit Recorded(const std::string& map = test::source_path("maps/office_floor.geojson"),
-                    const std::string& flags = "",
-                    const std::string& robot = test::source_path("maps/robots/pioneer.json")) {
-    fs::create_directories(dir);
-    const std::string route =
-        flags.find("--route") == std::string::npos ? "--route 'E1 -> K2' " : "";
-    const auto r = test::run_lampnav("sim " + route + "--map '" + map + "' --robot '" + robot +
-                                     "' -o '" + log + "' " + flags);
-    EXPECT_EQ(r.status, 0) << r.err;
-  }
-  ~Recorded() { fs::remove_all(dir); }
-};
-
-// A built map's lamps against the true ones: each moved into the true map's frame by the
-// drive's first true pose and paired with the true lamp within 0.3 m; the errors after the best
-// rigid alignment (the map's frame is the drive's start). A lamp with no true lamp there, or a
-// true lamp matched twice, fails the test.
-struct LampErrors {
-  std::set<std::string> matched;             // true lamp ids
-  std::map<std::string, std::string> built;  // the built lamp's id on each true one
-  std::map<std::string, double> error;       // m, on each true one, after the alignment
-  double rms = 0, worst = 0;
-};
-
-LampErrors lamp_errors(const graph::TopologicalMap& built, const graph::TopologicalMap& truth,
-                       const Pose2& start, double within_m = 0.3) {
-  LampErrors e;
-  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> pairs;
-  std::vector<std::string> ids;  // the true lamp of each pair
-  for (const auto& n : built.nodes()) {
-    for (const auto& l : n.lamps) {
-      const Eigen::Vector2d at = start.transform_from(l.xyz.head<2>());
-      const auto near = truth.lamps_within(at, within_m);
-      if (near.empty()) {
-        ADD_FAILURE() << l.id.value << " at " << at.transpose() << ": no true lamp there";
-        continue;
-      }
-      e.built[near.front()->id.value] = l.id.value;
-      if (!e.matched.insert(near.front()->id.value).second)
-        ADD_FAILURE() << "twice: " << near.front()->id.value;
-      pairs.emplace_back(l.xyz.head<2>(), near.front()->xyz.head<2>());
-      ids.push_back(near.front()->id.value);
-    }
-  }
-  const Pose2 fit = mapping::fit_rigid(pairs);
-  double sum = 0;
-  for (std::size_t k = 0; k < pairs.size(); ++k) {
-    const auto& [b, t] = pairs[k];
-    const double err = (fit.transform_from(b) - t).norm();
-    e.error[ids[k]] = err;
-    e.worst = std::max(e.worst, err);
-    sum += err * err;
-  }
-  e.rms = std::sqrt(sum / std::max<std::size_t>(1, pairs.size()));
-  return e;
-}
+using test::lamp_errors;
+using test::LampErrors;
+using test::Recorded;
 
 // The true lamps of the places the drive E1 -> K2 passes under: C1, C5 and C4 and the places
 // between them (E1, J1, J2, K2).
@@ -522,66 +464,6 @@ TEST(MapBuild, LampsEightMetresUpAreMappedAsWell) {
   EXPECT_LE(e.worst, 0.05);
   for (const auto& n : built.nodes())
     for (const auto& l : n.lamps) EXPECT_NEAR(l.xyz.z(), 8.0, 0.03) << l.id.value;
-}
-
-// The office with two rows of lamps in its corridors, 1.5 m apart (a wide corridor's troffers),
-// driven E1 -> J1 -> J2 -> E2 on rendered frames: far down a side corridor the omni camera sees a
-// pair of lamps as one blob between them, near as two, and lines through a lamp of one row and
-// the next of the other are rows as well, askew. The junctions turned at have their ways out, once
-// each, and no place lies where none is; every lamp passed under is in the map once. Before,
-// rows side by side were a room's grid: both junctions came out corners; without taking the askew
-// rows of one way as one, the drive had a junction in the middle of C5.
-TEST(MapBuild, CorridorsOfTwoRowsKeepTheirWaysOut) {
-  const graph::TopologicalMap rows =
-      test::edited(graph::read_map(test::source_path("maps/office_floor.geojson")).map,
-                   [](graph::Node& n) { test::two_rows(n, 0.75); });
-  const fs::path dir =
-      fs::temp_directory_path() / ("lampnav_two_rows_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  const std::string map = (dir / "two_rows.geojson").string(), log = (dir / "drive.mcap").string(),
-                    out = (dir / "built.geojson").string();
-  std::ofstream(map) << graph::write_map(rows);
-  const auto sim =
-      test::run_lampnav("sim --route 'E1 -> E2' --seed 5 --map '" + map + "' --robot " +
-                        test::quoted_source("maps/robots/pioneer.json") + " -q -o '" + log + "'");
-  ASSERT_EQ(sim.status, 0) << sim.err;
-  const auto r = test::run_lampnav("map build '" + log + "' -o '" + out + "' --quiet");
-  ASSERT_EQ(r.status, 0) << r.err;
-  std::cout << r.out;
-  const graph::TopologicalMap truth = graph::read_map(map).map, built = graph::read_map(out).map;
-  const Pose2 start = io::read_mission_log(log).truth.front().value.pose;
-  const LampErrors e = lamp_errors(built, truth, start);
-  std::size_t under = 0;
-  for (const char* name : {"E1", "C1", "J1", "C5", "J2", "C6", "E2"})
-    under += truth.find_node(name)->lamps.size();
-  EXPECT_EQ(e.matched.size(), under);
-  std::cout << e.matched.size() << " lamps, error rms " << e.rms * 100 << " cm, max "
-            << e.worst * 100 << " cm\n";
-  std::map<std::string, std::string> kinds;  // the true place holding each built place: its kind
-  for (const auto& n : built.nodes()) {
-    if (n.place == graph::Place::corridor) continue;
-    const graph::Node* t = truth.node_containing(start.transform_from(n.point));
-    kinds[t ? t->name : "nowhere"] = graph::to_string(n.place);
-  }
-  const std::map<std::string, std::string> want = {
-      {"E1", "end"}, {"J1", "junction"}, {"J2", "junction"}, {"E2", "end"}};
-  EXPECT_EQ(kinds, want);
-  EXPECT_EQ(built.node_count(), 7u);  // and three corridors
-  fs::remove_all(dir);
-}
-
-// Corridors 4 m wide with two rows of lamps 2.4 m apart, driven down the middle between them:
-// the ceiling camera sees the lamps only cut by its border, and maps one lamp in 61 m. The map
-// is valid (exit 0), and a note says why it is nearly empty and how to drive.
-TEST(MapBuild, LampsPassedBesideAreSaidSo) {
-  const Recorded rec(test::source_path("tests/fixtures/maps/wide_corridors_two_rows.geojson"),
-                     "--seed 5 --route 'E1 -> E3'");
-  const auto r = test::run_lampnav("map build '" + rec.log + "' -o '" +
-                                   (rec.dir / "built.geojson").string() + "' --quiet");
-  ASSERT_EQ(r.status, 0) << r.err;
-  std::cout << r.out << r.err;
-  EXPECT_THAT(r.err, HasSubstr("most lamps were seen cut by the image's border"));
-  EXPECT_THAT(r.err, HasSubstr("drive under a row of lamps"));
 }
 
 // A map built from one drive along C1 and C2 (anchored at the drive's true start), then another

@@ -63,7 +63,7 @@ TEST(MapBuilder, LampsOnlyEverCutByTheBorderSayHowToDrive) {
   } catch (const JobFailed& e) {
     EXPECT_THAT(std::string(e.what()), HasSubstr("beside.mcap"));
     EXPECT_THAT(std::string(e.what()), HasSubstr("only lamps cut by the image's border"));
-    EXPECT_THAT(std::string(e.what()), HasSubstr("drive under a row of lamps"));
+    EXPECT_THAT(std::string(e.what()), HasSubstr("drive under the rows of lamps"));
   }
 }
 

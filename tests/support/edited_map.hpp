@@ -73,4 +73,19 @@ inline void to_one_side(graph::Node& n, double offset) {
   for (graph::Lamp& l : n.lamps) l.xyz.head<2>() += offset * Eigen::Vector2d(-along.y(), along.x());
 }
 
+// A second row beside each corridor's lamps, `apart` m to the left of its axis (walking it from its
+// first end), the first row under the axis (ids -L1b, ...): a wide corridor driven under one of
+// its two rows. Places' lamps as they were.
+inline void row_beside(graph::Node& n, double apart) {
+  if (n.place != graph::Place::corridor || !n.axis) return;
+  const Eigen::Vector2d along = n.axis->direction();
+  const std::size_t count = n.lamps.size();
+  for (std::size_t i = 0; i < count; ++i) {
+    graph::Lamp c = n.lamps[i];
+    c.id = LampId{c.id.value + "b"};
+    c.xyz.head<2>() += apart * Eigen::Vector2d(-along.y(), along.x());
+    n.lamps.push_back(c);
+  }
+}
+
 }  // namespace lampnav::test

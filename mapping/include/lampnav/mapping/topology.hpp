@@ -65,6 +65,9 @@ struct TopologyOptions {
   // rows or more), it widens the rows of ways (each lamp within way_across_m plus it of the row's
   // line), the runs' own lamps, and the lamps beside a row that are not its own.
   double rows_reach_m = 1.5;
+  // A row of the omni camera's lamps beside a run's mapped lamps, within row_beside_m, along half
+  // the mapped row, its lamps as close: the corridor's other row, not mapped (a note says so).
+  double row_beside_m = 2.5;
   int way_min_lamps = 3;
   double way_across_m = 0.3;
   double way_gap_m = 5.0;
@@ -79,6 +82,8 @@ struct TopologyReport {
   std::size_t lamps_placed = 0;
   std::size_t lamps_outside = 0;  // lamps in no place's region (left out of the map)
   std::size_t ways_seen = 0;      // ways out seen, not driven, that changed a place's kind
+  std::size_t rows_beside = 0;    // rows of lamps the omni camera saw beside a corridor, unmapped
+  std::size_t lanes_joined = 0;   // lanes under a wide corridor's two rows, joined as one corridor
   std::vector<std::string> notes;
 };
 
