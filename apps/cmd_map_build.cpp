@@ -262,7 +262,9 @@ void add_map_build_command(CLI::App& map, Job& run) {
   build->add_option("-o,--output", args->out, "Map to write (.geojson)")->required();
   build->add_option("--names", args->names,
                     "NAMES.json: [{\"name\": ..., \"at\": [x, y]}], a point inside each place");
-  build->add_option("--corridor-width", args->corridor_width, "Width of the places' regions (m)")
+  build
+      ->add_option("--corridor-width", args->corridor_width,
+                   "Width of the places' regions (m; wider where a corridor's two rows need it)")
       ->capture_default_str()
       ->check(CLI::Range(0.5, 20.0));
   build->add_option("--initial-pose", args->initial_pose,

@@ -72,10 +72,11 @@ std::vector<std::pair<double, double>> rows_of(const std::vector<double>& off) {
 
 }  // namespace
 
-int join_lanes_under_two_rows(std::vector<Line>& lines, const std::vector<MappedLamp>& lamps,
-                              const TopologyOptions& o) {
+std::vector<double> join_lanes_under_two_rows(std::vector<Line>& lines,
+                                              const std::vector<MappedLamp>& lamps,
+                                              const TopologyOptions& o) {
   const double parallel = std::sin(o.parallel_deg * M_PI / 180);
-  int joined = 0;
+  std::vector<double> joined;
   for (std::size_t i = 0; i < lines.size(); ++i)
     for (std::size_t j = i + 1; j < lines.size(); ++j) {
       Line &A = lines[i], &B = lines[j];
@@ -120,7 +121,7 @@ int join_lanes_under_two_rows(std::vector<Line>& lines, const std::vector<Mapped
       A = mid;
       lines.erase(lines.begin() + static_cast<std::ptrdiff_t>(j));
       --j;
-      ++joined;
+      joined.push_back(middle(1) - middle(0));
     }
   return joined;
 }

@@ -38,9 +38,10 @@ struct Run {
 // row_beside_m) over more than hall_min_overlap_m, whose mapped lamps there (out to row_beside_m
 // beyond either) stand in exactly two rows, each line under one of them (within same_line_m). Such
 // lanes are one corridor, not a hall: the pair becomes one line half way between them, holding both
-// lines' stretches. Returns how many pairs were joined.
-int join_lanes_under_two_rows(std::vector<Line>& lines, const std::vector<MappedLamp>& lamps,
-                              const TopologyOptions& o);
+// lines' stretches. Returns how far apart the two rows of each pair joined are.
+std::vector<double> join_lanes_under_two_rows(std::vector<Line>& lines,
+                                              const std::vector<MappedLamp>& lamps,
+                                              const TopologyOptions& o);
 
 // Halls from lanes: the pieces of runs with another beside them, grouped where they touch; a
 // group is a hall when the lamps around it stand in rows along its lanes, spread across them.

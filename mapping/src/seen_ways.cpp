@@ -172,8 +172,8 @@ std::vector<SeenWay> ways_not_driven(const std::vector<Line>& lines, const std::
     for (const Vector2d& p : around) {
       const Vector2d e = p - row.first;
       const double off = std::abs(u.x() * e.y() - u.y() * e.x()), s = u.dot(e);
-      beside += off > 4 * o.way_across_m + 2 * rows_band && off < o.way_clear_m && s > -o.way_clear_m &&
-                s < length + o.way_clear_m;
+      beside += off > 4 * o.way_across_m + 2 * rows_band && off < o.way_clear_m &&
+                s > -o.way_clear_m && s < length + o.way_clear_m;
     }
     if (beside > 1) continue;
     for (const auto& r : runs) {

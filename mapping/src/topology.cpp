@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <optional>
 #include <set>
 
@@ -151,8 +152,6 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
                                      const std::vector<Vector2d>& seen) {
   o.validate();
   TopologyReport rep;
-  const double w = o.corridor_width_m;
-  const double near = std::max(o.place_m, w);
   std::vector<Vector2d> pts;
   for (const auto& k : mapped.keyframes) pts.push_back(k.pose.translation());
   graph::TopologicalMap map("built");
@@ -193,8 +192,23 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     const double sa = L.along(a), sb = L.along(b);
     L.intervals.emplace_back(std::min(sa, sb), std::max(sa, sb));
   }
-  // A wide corridor driven up one of its rows and back along the other is one corridor.
-  rep.lanes_joined = static_cast<std::size_t>(join_lanes_under_two_rows(lines, mapped.lamps, o));
+  // A wide corridor driven up one of its rows and back along the other is one corridor, as wide
+  // as its rows and 0.4 m beyond each (the regions' width, when more than the option's).
+  const std::vector<double> joined = join_lanes_under_two_rows(lines, mapped.lamps, o);
+  rep.lanes_joined = joined.size();
+  double w = o.corridor_width_m;
+  for (const double apart : joined) w = std::max(w, apart + 0.8);
+  if (w > o.corridor_width_m) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "corridors are %.1f m wide, not %.1f: the rows of a corridor driven under "
+                  "each are %.1f m apart",
+                  w, o.corridor_width_m, w - 0.8);
+    rep.notes.push_back(buf);
+  }
+  const double near = std::max(o.place_m, w);
+  TopologyOptions wide = o;  // for the steps that take the corridors' width from the options
+  wide.corridor_width_m = w;
   std::vector<Run> runs;
   for (std::size_t l = 0; l < lines.size(); ++l) {
     auto iv = lines[l].intervals;
@@ -212,7 +226,7 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
   // 1b. Halls, and the runs with their stretches through halls cut out.
   std::vector<graph::Polygon> halls = halls_from_lanes(lines, runs, mapped.lamps, o);
   if (o.hall_min_lamps > 0) {
-    const auto beside = halls_beside(lines, runs, mapped.lamps, halls, o);
+    const auto beside = halls_beside(lines, runs, mapped.lamps, halls, wide);
     halls.insert(halls.end(), beside.begin(), beside.end());
   }
   merge_overlapping(halls);
@@ -256,7 +270,7 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
   // 2b. Ways out not driven, seen: where one meets a run is a place.
   const std::vector<RowBeside> unmapped_rows = rows_beside(lines, runs, mapped.lamps, seen, o);
   const std::vector<SeenWay> seen_ways =
-      ways_not_driven(lines, runs, mapped.lamps, seen, unmapped_rows, o);
+      ways_not_driven(lines, runs, mapped.lamps, seen, unmapped_rows, wide);
   for (const SeenWay& x : seen_ways) add_place(x.at);
   // Ways out of each place: the runs that go on from it by more than a place's size.
   // Where a point lies along a run (the distance along its line), if the run passes it.
