@@ -18,6 +18,23 @@ double signed_across(const Line& L, const Vector2d& p) {
   return d.x() * L.dir.y() - d.y() * L.dir.x();
 }
 
+// The mapped lamps along run `r` of `L` within rows_reach_m of it: their signed offsets across
+// it and their distances along it.
+void mapped_along(const Line& L, const Run& r, const std::vector<MappedLamp>& lamps,
+                  const TopologyOptions& o, std::vector<double>& across,
+                  std::vector<double>& along) {
+  across.clear();
+  along.clear();
+  for (const MappedLamp& l : lamps) {
+    const Vector2d p = l.xyz.head<2>();
+    const double s = L.along(p), a = signed_across(L, p);
+    if (s >= r.s0 && s <= r.s1 && std::abs(a) <= o.rows_reach_m) {
+      across.push_back(a);
+      along.push_back(s);
+    }
+  }
+}
+
 // Where a corridor's lamps stand across it, from the lamps the drive passed under: their signed
 // offsets from each run's line (right positive), within `rows_reach_m` of it and along it, for
 // runs of at least 4 such lamps. `centre`, per run: the middle of their spread (10th to 90th
@@ -33,15 +50,9 @@ struct RowsAcross {
 RowsAcross rows_across(const std::vector<Line>& lines, const std::vector<Run>& runs,
                        const std::vector<MappedLamp>& lamps, const TopologyOptions& o) {
   RowsAcross out;
-  std::vector<double> halves, offsets;
+  std::vector<double> halves, offsets, along;
   for (const auto& r : runs) {
-    const Line& L = lines[r.line];
-    offsets.clear();
-    for (const MappedLamp& l : lamps) {
-      const Vector2d p = l.xyz.head<2>();
-      const double s = L.along(p), across = signed_across(L, p);
-      if (s >= r.s0 && s <= r.s1 && std::abs(across) <= o.rows_reach_m) offsets.push_back(across);
-    }
+    mapped_along(lines[r.line], r, lamps, o, offsets, along);
     out.centre.push_back(0);
     if (offsets.size() < 4) continue;
     std::sort(offsets.begin(), offsets.end());
@@ -66,16 +77,7 @@ std::vector<RowBeside> rows_beside(const std::vector<Line>& lines, const std::ve
   for (std::size_t k = 0; k < runs.size(); ++k) {
     const Run& r = runs[k];
     const Line& L = lines[r.line];
-    offsets.clear();
-    along.clear();
-    for (const MappedLamp& l : lamps) {
-      const Vector2d p = l.xyz.head<2>();
-      const double s = L.along(p), across = signed_across(L, p);
-      if (s >= r.s0 && s <= r.s1 && std::abs(across) <= o.rows_reach_m) {
-        offsets.push_back(across);
-        along.push_back(s);
-      }
-    }
+    mapped_along(L, r, lamps, o, offsets, along);
     if (offsets.size() < 4) continue;
     std::sort(offsets.begin(), offsets.end());
     const std::size_t n = offsets.size() - 1;
