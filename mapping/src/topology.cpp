@@ -571,11 +571,13 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     std::string where = "the drive";
     for (std::size_t i = 0; i < nodes.size(); ++i)
       if (!dropped[i] && nodes[i].region.contains(b.middle, 0.5)) where = nodes[i].name;
-    char buf[256];
+    char buf[400];
     std::snprintf(buf, sizeof buf,
                   "the omni camera saw another row of lamps %.1f m beside %s, along %.0f m of it "
                   "(towards heading %d degrees in the map's frame), that the map does not hold: "
-                  "the ceiling camera saw them only at its border; drive under that row too",
+                  "the ceiling camera saw them only at its border; drive under that row too (a "
+                  "robot under that row, on this map, may be placed under the mapped one: "
+                  "docs/mapping.md, \"Not done\")",
                   b.apart_m, where.c_str(), b.length_m, heading_deg(b.towards));
     rep.notes.push_back(buf);
     ++rep.rows_beside;
