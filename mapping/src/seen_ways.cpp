@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "median.hpp"
 #include "omni_ways.hpp"
@@ -18,28 +19,41 @@ double signed_across(const Line& L, const Vector2d& p) {
   return d.x() * L.dir.y() - d.y() * L.dir.x();
 }
 
-// The mapped lamps along run `r` of `L` within rows_reach_m of it: their signed offsets across
-// it and their distances along it.
-void mapped_along(const Line& L, const Run& r, const std::vector<MappedLamp>& lamps,
-                  const TopologyOptions& o, std::vector<double>& across,
-                  std::vector<double>& along) {
-  across.clear();
-  along.clear();
+// Where the lamps the drive passed under stand across and along run `r` of `L`: those within
+// rows_reach_m of its line and along it, for a run of at least 4 of them (else nothing). Their
+// signed offsets' 10th and 90th percentiles (`lo`, `hi`), and where along the line the first and
+// last of them are.
+struct MappedSpread {
+  double lo = 0, hi = 0, s0 = 0, s1 = 0;
+  std::size_t lamps = 0;
+};
+
+std::optional<MappedSpread> mapped_spread(const Line& L, const Run& r,
+                                          const std::vector<MappedLamp>& lamps,
+                                          const TopologyOptions& o) {
+  std::vector<double> across;
+  MappedSpread m;
   for (const MappedLamp& l : lamps) {
     const Vector2d p = l.xyz.head<2>();
     const double s = L.along(p), a = signed_across(L, p);
-    if (s >= r.s0 && s <= r.s1 && std::abs(a) <= o.rows_reach_m) {
-      across.push_back(a);
-      along.push_back(s);
-    }
+    if (s < r.s0 || s > r.s1 || std::abs(a) > o.rows_reach_m) continue;
+    m.s0 = across.empty() ? s : std::min(m.s0, s);
+    m.s1 = across.empty() ? s : std::max(m.s1, s);
+    across.push_back(a);
   }
+  if (across.size() < 4) return std::nullopt;
+  std::sort(across.begin(), across.end());
+  const std::size_t n = across.size() - 1;
+  m.lo = across[n / 10];
+  m.hi = across[n - n / 10];
+  m.lamps = across.size();
+  return m;
 }
 
-// Where a corridor's lamps stand across it, from the lamps the drive passed under: their signed
-// offsets from each run's line (right positive), within `rows_reach_m` of it and along it, for
-// runs of at least 4 such lamps. `centre`, per run: the middle of their spread (10th to 90th
-// percentile), 0 for a run of fewer lamps; near 0 where the robot drives under a row, 0.7 m where
-// the lamps hang to one side of the corridor and the robot drives down its middle.
+// Where a corridor's lamps stand across it, from the lamps the drive passed under (their signed
+// offsets from each run's line, right positive: mapped_spread). `centre`, per run: the middle of
+// their spread, 0 for a run of fewer than 4 lamps; near 0 where the robot drives under a row,
+// 0.7 m where the lamps hang to one side of the corridor and the robot drives down its middle.
 // `half_spread`: half that spread, the median over runs; near 0 for one row (the robot weaves a
 // little), half the rows' spacing for two (a wide corridor's two rows of troffers).
 struct RowsAcross {
@@ -50,15 +64,11 @@ struct RowsAcross {
 RowsAcross rows_across(const std::vector<Line>& lines, const std::vector<Run>& runs,
                        const std::vector<MappedLamp>& lamps, const TopologyOptions& o) {
   RowsAcross out;
-  std::vector<double> halves, offsets, along;
+  std::vector<double> halves;
   for (const auto& r : runs) {
-    mapped_along(lines[r.line], r, lamps, o, offsets, along);
-    out.centre.push_back(0);
-    if (offsets.size() < 4) continue;
-    std::sort(offsets.begin(), offsets.end());
-    const std::size_t n = offsets.size() - 1, lo = n / 10, hi = n - n / 10;
-    halves.push_back((offsets[hi] - offsets[lo]) / 2);
-    out.centre.back() = (offsets[hi] + offsets[lo]) / 2;
+    const auto m = mapped_spread(lines[r.line], r, lamps, o);
+    out.centre.push_back(m ? (m->hi + m->lo) / 2 : 0.0);
+    if (m) halves.push_back((m->hi - m->lo) / 2);
   }
   out.half_spread = halves.empty() ? 0.0 : median(halves);
   return out;
@@ -72,28 +82,24 @@ std::vector<RowBeside> rows_beside(const std::vector<Line>& lines, const std::ve
   // From the mapped row; between a row's lamps, across; between two lamps of a row, along.
   constexpr double kClear = 0.5, kGap = 0.4, kSame = 1.0;
   std::vector<RowBeside> out;
-  std::vector<double> offsets, along;
   std::vector<std::pair<double, double>> near;  // seen beside: (offset, along)
   for (std::size_t k = 0; k < runs.size(); ++k) {
-    const Run& r = runs[k];
-    const Line& L = lines[r.line];
-    mapped_along(L, r, lamps, o, offsets, along);
-    if (offsets.size() < 4) continue;
-    std::sort(offsets.begin(), offsets.end());
-    const std::size_t n = offsets.size() - 1;
-    const double lo = offsets[n / 10], hi = offsets[n - n / 10];
-    const auto [s0, s1] = std::minmax_element(along.begin(), along.end());
+    const Line& L = lines[runs[k].line];
+    const auto m = mapped_spread(L, runs[k], lamps, o);
+    if (!m) continue;
+    const double lo = m->lo, hi = m->hi;
     near.clear();
     for (const Vector2d& p : seen) {
       const double s = L.along(p), across = signed_across(L, p);
-      if (s >= *s0 && s <= *s1 && std::abs(across) <= o.row_beside_m &&
+      if (s >= m->s0 && s <= m->s1 && std::abs(across) <= o.row_beside_m &&
           (across < lo - kClear || across > hi + kClear))
         near.push_back({across, s});
     }
     std::sort(near.begin(), near.end());
-    // The mapped row's spacing; the other row's lamps are as close (a room's lamps beside a
-    // corridor, one a room, are further apart: the generated buildings' rooms, 2.4 m off the axis).
-    const double spacing = (*s1 - *s0) / double(offsets.size() - 1);
+    // The mapped row's spacing; the other row's lamps are as close. A room's grid beside a
+    // corridor is sparser: the generated buildings' rooms have their nearest row of lamps 2.4 m
+    // off the corridor's axis, 4 m apart against the corridor's 2.25 m.
+    const double spacing = (m->s1 - m->s0) / double(m->lamps - 1);
     RowBeside best;
     std::vector<double> at;
     for (std::size_t a = 0, b = 0; a < near.size(); a = b) {
@@ -105,19 +111,18 @@ std::vector<RowBeside> rows_beside(const std::vector<Line>& lines, const std::ve
       int count = 1;
       for (std::size_t i = 1; i < at.size(); ++i) count += at[i] - at[i - 1] > kSame;
       const double length = at.back() - at.front();
-      if (count < 4 || length < 0.5 * (*s1 - *s0) || length / (count - 1) > 1.5 * spacing ||
+      if (count < 4 || length < 0.5 * (m->s1 - m->s0) || length / (count - 1) > 1.5 * spacing ||
           count <= best.lamps)
         continue;
       const double other = near[a + (b - a) / 2].first, mine = other > hi ? hi : lo;
       const Vector2d right(L.dir.y(), -L.dir.x());
       best.run = static_cast<int>(k);
-      best.middle = L.at(0.5 * (*s0 + *s1)) + 0.5 * (lo + hi) * right;
+      best.middle = L.at(0.5 * (m->s0 + m->s1)) + 0.5 * (lo + hi) * right;
       best.towards = other > hi ? right : Vector2d(-right);
       best.offset = other;
       best.apart_m = std::abs(other - mine);
       best.s0 = at.front();
       best.s1 = at.back();
-      best.length_m = length;
       best.lamps = count;
     }
     if (best.lamps > 0) out.push_back(best);

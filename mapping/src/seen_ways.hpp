@@ -24,7 +24,6 @@ struct RowBeside {
   double offset = 0;      // of the other row from the run's line (positive to its right)
   double s0 = 0, s1 = 0;  // where the other row begins and ends along the run's line
   double apart_m = 0;     // between the two rows
-  double length_m = 0;    // of the other row, along the run
   int lamps = 0;          // seen in the other row
 };
 std::vector<RowBeside> rows_beside(const std::vector<Line>& lines, const std::vector<Run>& runs,

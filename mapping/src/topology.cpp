@@ -194,16 +194,17 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
   }
   // A wide corridor driven up one of its rows and back along the other is one corridor, as wide
   // as its rows and 0.4 m beyond each (the regions' width, when more than the option's).
+  constexpr double kBeyondRows = 0.4;
   const std::vector<double> joined = join_lanes_under_two_rows(lines, mapped.lamps, o);
   rep.lanes_joined = joined.size();
-  double w = o.corridor_width_m;
-  for (const double apart : joined) w = std::max(w, apart + 0.8);
+  const double widest = joined.empty() ? 0.0 : *std::max_element(joined.begin(), joined.end());
+  const double w = std::max(o.corridor_width_m, widest + 2 * kBeyondRows);
   if (w > o.corridor_width_m) {
     char buf[200];
     std::snprintf(buf, sizeof buf,
                   "corridors are %.1f m wide, not %.1f: the rows of a corridor driven under "
                   "each are %.1f m apart",
-                  w, o.corridor_width_m, w - 0.8);
+                  w, o.corridor_width_m, widest);
     rep.notes.push_back(buf);
   }
   const double near = std::max(o.place_m, w);
@@ -578,7 +579,7 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
                   "the ceiling camera saw them only at its border; drive under that row too (a "
                   "robot under that row, on this map, may be placed under the mapped one: "
                   "docs/mapping.md, \"Not done\")",
-                  b.apart_m, where.c_str(), b.length_m, heading_deg(b.towards));
+                  b.apart_m, where.c_str(), b.s1 - b.s0, heading_deg(b.towards));
     rep.notes.push_back(buf);
     ++rep.rows_beside;
   }
