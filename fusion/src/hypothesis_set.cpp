@@ -15,6 +15,7 @@
 #include "map_evidence.hpp"
 #include "map_geometry.hpp"
 #include "pose_grid.hpp"
+#include "unmapped_rows.hpp"
 
 namespace lampnav::fusion {
 
@@ -55,6 +56,28 @@ struct HypothesisSet::Impl {
   std::vector<Place> places;
   std::pair<Stamp, Pose2> places_at;  // the capture every place stands at, dead-reckoned pose
   mutable std::map<std::pair<int, int>, bool> twin_cache;  // by hypothesis ids
+  // The last row the map does not hold that an omni image showed beside the leader
+  // (unmapped_rows.hpp), kept until the robot has travelled row_beside_memory_m since: the
+  // leader is not published meanwhile.
+  std::optional<UnmappedRow> row_beside;
+  Stamp row_seen_at;
+
+  void note_row_beside(Stamp stamp, const OdometryTrack& odo, bool omni_frame) {
+    if (row_beside && stamp > row_seen_at &&
+        odo.travel(row_seen_at, stamp) >= o.row_beside_memory_m)
+      row_beside.reset();
+    if (!omni_frame || hs.empty() || !(o.row_beside_m > 0)) return;
+    const Hypothesis& h = hs.front();
+    detail::UnmappedRowOptions ro;
+    ro.max_offset_m = o.row_beside_m;
+    ro.min_lamps = o.row_beside_min_lamps;
+    ro.reach_m = o.stray_reach_max_m;
+    if (auto row = detail::unmapped_row_beside(*map, h.pose, h.strays, ro)) {
+      row_beside = row;
+      row_seen_at = stamp;
+      ++counts.unmapped_rows;
+    }
+  }
 
   // Whether the rigid motion taking pose a to pose b maps the map onto itself (map_geometry.hpp):
   // then the two places look alike from everywhere, whatever the robot does.
@@ -460,6 +483,7 @@ void HypothesisSet::clear(const std::string& why) {
   m.complete = false;
   m.omni_frames = 0;
   m.view_beyond_map = false;
+  m.row_beside.reset();
   m.twin_cache.clear();
   m.last_enumeration.reset();
   m.places.clear();
@@ -516,6 +540,7 @@ void HypothesisSet::omni(Stamp stamp, const vision::OmniDetection& d,
     m.births(stamp, d, odometry);
     m.tidy();
   }
+  m.note_row_beside(stamp, odometry, true);
 }
 
 void HypothesisSet::ceiling(Stamp stamp, const std::vector<vision::LampDetection>& lamps,
@@ -528,6 +553,7 @@ void HypothesisSet::ceiling(Stamp stamp, const std::vector<vision::LampDetection
   m.note_travel(stamp, odometry);
   m.tidy();
   if (m.complete && m.hs.empty()) m.reset("every hypothesis went through a wall");
+  m.note_row_beside(stamp, odometry, false);
 }
 
 const std::vector<Hypothesis>& HypothesisSet::hypotheses() const { return impl_->hs; }
@@ -539,7 +565,7 @@ const Hypothesis* HypothesisSet::winner() const {
       m.travel_to_publish() > 0)
     return nullptr;
   const Hypothesis& best = m.hs.front();
-  if (best.weight < m.o.publish_posterior || best.contradicted) return nullptr;
+  if (best.weight < m.o.publish_posterior || best.contradicted || m.row_beside) return nullptr;
   if (m.hs.size() > 1 && m.hs[0].log_weight - m.hs[1].log_weight < std::log(m.o.publish_ratio))
     return nullptr;
   return &best;
@@ -573,6 +599,14 @@ std::string HypothesisSet::why() const {
         s << ", waiting for " << metres
           << " m more of travel: the view shows lamps beyond the map's places, so the robot may "
              "be where the map has nothing";
+      }
+      if (const auto& row = m.row_beside) {
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      ", and the omni camera sees a row of %d lamps %.1f m beside the mapped row "
+                      "that the map does not hold: the robot may be under that row",
+                      row->lamps, row->offset_m);
+        s << text;
       }
       return s.str();
     case HypothesisVerdict::symmetric:

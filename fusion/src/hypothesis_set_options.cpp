@@ -72,6 +72,10 @@ void HypothesisSetOptions::validate() const {
   check(beyond_map_blob_cost >= 0 && std::isfinite(beyond_map_blob_cost), "beyond_map_blob_cost",
         "must be finite and not negative");
   check(map_sigma_m >= 0, "map_sigma_m", "must not be negative");
+  check(row_beside_m >= 0 && row_beside_m <= 10, "row_beside_m", "must be 0 to 10 m");
+  check(row_beside_min_lamps >= 3, "row_beside_min_lamps", "must be at least 3");
+  check(row_beside_memory_m >= 0 && std::isfinite(row_beside_memory_m), "row_beside_memory_m",
+        "must be a finite distance, at least 0");
   check(fit_gate_probability > 0 && fit_gate_probability < 1, "fit_gate_probability",
         "must be in (0, 1)");
   check(omni_tie_cost >= 0 && omni_tie_cost < frame_cost_cap, "omni_tie_cost",

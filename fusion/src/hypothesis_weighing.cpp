@@ -78,6 +78,7 @@ double HypothesisWeigher::charge_image(
     Hypothesis& h, const std::vector<const graph::Lamp*>& missed, int unexplained,
     const std::vector<StraySighting>& strays,
     const std::vector<std::pair<const graph::Lamp*, double>>& lamp_costs) const {
+  h.strays = strays;
   const double each = omni_->options().pairs.miss_cost;
   const double stray = omni_->options().pairs.spurious_cost;
   double delta = charge_absences(h.map_costs.lamps, missed, each, o_->lamp_out_cost) -
