@@ -576,9 +576,9 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
     std::snprintf(buf, sizeof buf,
                   "the omni camera saw another row of lamps %.1f m beside %s, along %.0f m of it "
                   "(towards heading %d degrees in the map's frame), that the map does not hold: "
-                  "the ceiling camera saw them only at its border; drive under that row too (a "
-                  "robot under that row, on this map, may be placed under the mapped one: "
-                  "docs/mapping.md, \"Not done\")",
+                  "the ceiling camera saw them only at its border; drive under that row too (on "
+                  "this map, a robot there not told its start stays unsure which row it is "
+                  "under: docs/mapping.md, \"Corridors of two rows\")",
                   b.apart_m, where.c_str(), b.s1 - b.s0, heading_deg(b.towards));
     rep.notes.push_back(buf);
     ++rep.rows_beside;
