@@ -62,22 +62,40 @@ struct HypothesisSet::Impl {
   std::optional<UnmappedRow> row_beside;
   Stamp row_seen_at;
 
+  // How many of the last unexplained_window ceiling frames showed `h` a lamp in full view where
+  // it has no map lamp; whether that is publish_unexplained_frames or more.
+  int unexplained_count(const Hypothesis& h) const {
+    const std::uint32_t window =
+        o.unexplained_window >= 32 ? ~0u : (1u << o.unexplained_window) - 1;
+    return __builtin_popcount(h.unexplained_frames & window);
+  }
+  bool unexplained_lately(const Hypothesis& h) const {
+    return o.publish_unexplained_frames > 0 && unexplained_count(h) >= o.publish_unexplained_frames;
+  }
+
   void note_row_beside(Stamp stamp, const OdometryTrack& odo, bool omni_frame) {
     if (row_beside && stamp > row_seen_at &&
         odo.travel(row_seen_at, stamp) >= o.row_beside_memory_m)
       row_beside.reset();
     if (!omni_frame || hs.empty() || !(o.row_beside_m > 0)) return;
-    const Hypothesis& h = hs.front();
     detail::UnmappedRowOptions ro;
     ro.max_offset_m = o.row_beside_m;
     ro.min_lamps = o.row_beside_min_lamps;
-    ro.reach_m = o.stray_reach_max_m;
-    if (auto row = detail::unmapped_row_beside(*map, h.pose, h.strays, ro)) {
-      row_beside = row;
-      row_seen_at = stamp;
-      ++counts.unmapped_rows;
+    ro.reach_m = o.row_beside_reach_m;
+    // Every place along the mapped row sees the row beside, the truth among them or not: the
+    // likeliest few are asked, and the first that sees it speaks for the set.
+    const std::size_t asked = std::min<std::size_t>(hs.size(), kRowBesideAsked);
+    for (std::size_t k = 0; k < asked; ++k) {
+      if (hs[k].contradicted) continue;  // its image fits it nowhere: its strays are its view
+      if (auto row = detail::unmapped_row_beside(*map, hs[k].pose, hs[k].strays, ro)) {
+        row_beside = row;
+        row_seen_at = stamp;
+        ++counts.unmapped_rows;
+        return;
+      }
     }
   }
+  static constexpr std::size_t kRowBesideAsked = 8;
 
   // Whether the rigid motion taking pose a to pose b maps the map onto itself (map_geometry.hpp):
   // then the two places look alike from everywhere, whatever the robot does.
@@ -469,6 +487,19 @@ struct HypothesisSet::Impl {
   }
 };
 
+void Hypothesis::keep_strays(const std::vector<StraySighting>& latest, int images) {
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < strays.size(); ++k) {
+    if (stray_age[k] + 1 >= images) continue;
+    strays[kept] = strays[k];
+    stray_age[kept++] = stray_age[k] + 1;
+  }
+  strays.resize(kept);
+  stray_age.resize(kept);
+  strays.insert(strays.end(), latest.begin(), latest.end());
+  stray_age.resize(strays.size(), 0);
+}
+
 HypothesisSet::HypothesisSet(const graph::TopologicalMap& map,
                              const CameraDescription* ceiling_camera, const GlobalLocalizer* omni,
                              const CeilingPipelineOptions& ceiling_options,
@@ -565,7 +596,9 @@ const Hypothesis* HypothesisSet::winner() const {
       m.travel_to_publish() > 0)
     return nullptr;
   const Hypothesis& best = m.hs.front();
-  if (best.weight < m.o.publish_posterior || best.contradicted || m.row_beside) return nullptr;
+  if (best.weight < m.o.publish_posterior || best.contradicted || m.row_beside ||
+      m.unexplained_lately(best))
+    return nullptr;
   if (m.hs.size() > 1 && m.hs[0].log_weight - m.hs[1].log_weight < std::log(m.o.publish_ratio))
     return nullptr;
   return &best;
@@ -600,6 +633,10 @@ std::string HypothesisSet::why() const {
           << " m more of travel: the view shows lamps beyond the map's places, so the robot may "
              "be where the map has nothing";
       }
+      if (m.unexplained_lately(m.hs.front()))
+        s << ", and from the likeliest the ceiling camera saw lamps where the map has none in "
+          << m.unexplained_count(m.hs.front()) << " of its last " << m.o.unexplained_window
+          << " frames";
       if (const auto& row = m.row_beside) {
         char text[160];
         std::snprintf(text, sizeof text,

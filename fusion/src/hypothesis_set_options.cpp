@@ -76,6 +76,14 @@ void HypothesisSetOptions::validate() const {
   check(row_beside_min_lamps >= 3, "row_beside_min_lamps", "must be at least 3");
   check(row_beside_memory_m >= 0 && std::isfinite(row_beside_memory_m), "row_beside_memory_m",
         "must be a finite distance, at least 0");
+  check(row_beside_images >= 1 && row_beside_images <= 20, "row_beside_images",
+        "must be 1 to 20 images");
+  check(row_beside_reach_m > 0 && std::isfinite(row_beside_reach_m), "row_beside_reach_m",
+        "must be a positive distance");
+  check(unexplained_window >= 1 && unexplained_window <= 32, "unexplained_window",
+        "must be 1 to 32 frames");
+  check(publish_unexplained_frames >= 0 && publish_unexplained_frames <= unexplained_window,
+        "publish_unexplained_frames", "must be 0 to unexplained_window");
   check(fit_gate_probability > 0 && fit_gate_probability < 1, "fit_gate_probability",
         "must be in (0, 1)");
   check(omni_tie_cost >= 0 && omni_tie_cost < frame_cost_cap, "omni_tie_cost",

@@ -78,7 +78,7 @@ double HypothesisWeigher::charge_image(
     Hypothesis& h, const std::vector<const graph::Lamp*>& missed, int unexplained,
     const std::vector<StraySighting>& strays,
     const std::vector<std::pair<const graph::Lamp*, double>>& lamp_costs) const {
-  h.strays = strays;
+  h.keep_strays(strays, o_->row_beside_images);
   const double each = omni_->options().pairs.miss_cost;
   const double stray = omni_->options().pairs.spurious_cost;
   double delta = charge_absences(h.map_costs.lamps, missed, each, o_->lamp_out_cost) -
@@ -160,6 +160,7 @@ Weighed HypothesisWeigher::ceiling(Hypothesis& h,
     for (int k = 0; k < 2; ++k) label_covariance(k, k) = std::max(label_covariance(k, k), floor);
   }
   double cost = 0;
+  bool unexplained = false;
   for (const auto& d : lamps) {
     if (d.view == vision::LampView::partial) continue;
     const LabelResult r = labeller_->label(d, h.pose, label_covariance, taken);
@@ -168,8 +169,10 @@ Weighed HypothesisWeigher::ceiling(Hypothesis& h,
       taken.insert(r.lamp->id);
     } else if (r.outcome == LabelOutcome::no_candidate) {
       cost += unlabelled(h, d);
+      unexplained = true;
     }
   }
+  h.unexplained_frames = (h.unexplained_frames << 1) | (unexplained ? 1u : 0u);
   if (!lamps.empty())  // a dark frame says nothing of missing lamps
     cost += charge_absences(
         h.map_costs.lamps,

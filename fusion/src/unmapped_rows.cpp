@@ -15,6 +15,8 @@ constexpr double kLeastOffset = 0.5;
 // A stray row's lamps may be this many times the mapped row's spacing apart: a room's grid beside
 // a corridor (4 m apart, beside lamps 2.25 m apart in a generated building) is no row beside.
 constexpr double kSpacingRatio = 1.5;
+// Sightings nearer one another than this are of one lamp.
+constexpr double kSameLamp = 0.5;
 
 double median_gap(std::vector<double> s) {
   std::sort(s.begin(), s.end());
@@ -30,9 +32,19 @@ std::optional<UnmappedRow> unmapped_row_beside(const graph::TopologicalMap& map,
                                                const std::vector<StraySighting>& strays,
                                                const UnmappedRowOptions& o) {
   const Vector2d at = pose.translation();
-  std::vector<Vector2d> seen;
+  // One lamp seen in several images is one: the surest sightings first, each joining the first
+  // lamp within kSameLamp of it (the lamp where its first sighting put it).
+  std::vector<const StraySighting*> near;
   for (const StraySighting& b : strays)
-    if (b.reach <= o.reach_m && (b.at - at).norm() <= o.view_m) seen.push_back(b.at);
+    if (b.reach <= o.reach_m && (b.at - at).norm() <= o.view_m) near.push_back(&b);
+  std::stable_sort(near.begin(), near.end(), [](const StraySighting* a, const StraySighting* b) {
+    return a->reach < b->reach;
+  });
+  std::vector<Vector2d> seen;
+  for (const StraySighting* b : near)
+    if (std::none_of(seen.begin(), seen.end(),
+                     [&](const Vector2d& p) { return (p - b->at).norm() <= kSameLamp; }))
+      seen.push_back(b->at);
   if (static_cast<int>(seen.size()) < o.min_lamps) return std::nullopt;
   std::vector<Vector2d> mapped;
   for (const graph::Lamp* l : map.lamps_within(at, o.view_m + o.max_offset_m))
@@ -85,6 +97,9 @@ std::optional<UnmappedRow> unmapped_row_beside(const graph::TopologicalMap& map,
       }
     }
   }
+  // A row among many strays is no sign of a row the map lacks: the pose is wrong, and its view
+  // unexplained (a place after a carry, whose 18 strays in the museum held a row of 4).
+  if (best && 2 * best->lamps < static_cast<int>(seen.size())) return std::nullopt;
   return best;
 }
 

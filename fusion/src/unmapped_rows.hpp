@@ -21,7 +21,8 @@ namespace lampnav::fusion::detail {
 // within `band_m` of the line), consecutive ones no further apart than 1.5 times the mapped
 // row's spacing; and at least three of the map's lamps in a row parallel to it (within `band_m`
 // of a line at 0.5 m to `max_offset_m` from it) along the same stretch. The row found, the one
-// with the most lamps; none if no row is.
+// with the most lamps; none if no row is, or if it holds fewer than half of those strays (one
+// lamp per kSameLamp, 0.5 m): a pose whose view is mostly unexplained is wrong, not a row short.
 struct UnmappedRowOptions {
   double max_offset_m = 2.5;
   int min_lamps = 3;

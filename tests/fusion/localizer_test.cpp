@@ -356,7 +356,9 @@ TEST(Localizer, OmniUpdatesHoldTheHeadingWhereDiscsAreOut) {
 // truth, and the set published a place 8 m off (caught a second later). Now such an image starts
 // the places again; and since 2026-12-04 an image whose lamps misfit every hypothesis past
 // odd_image_misfit contradicts them all, which starts the set again too (`stale`, below, is the
-// old behaviour: both off).
+// old behaviour: both off, and the check of 2026-12-05 that also keeps that place from being
+// published, its ceiling frames showing lamps where it has none, off too; with that check on, the
+// stale set publishes nothing wrong either).
 TEST(Localizer, CarriedAwayWhileLostStartsThePlacesAgain) {
   World w("maps/office_floor.geojson");
   w.map = test::edited(w.map, test::sparse_round);
@@ -374,9 +376,14 @@ TEST(Localizer, CarriedAwayWhileLostStartsThePlacesAgain) {
   LocalizerOptions stale;
   stale.hypotheses.stale_places_cost = 1e9;
   stale.hypotheses.odd_image_misfit = 1e9;
+  LocalizerOptions stale_checked = stale;
+  stale.hypotheses.publish_unexplained_frames = 0;
   const Outcome before = replay(s, log, w.map, true, stale);
   std::cout << "kept to the drive's places: " << before.summary() << "\n";
   EXPECT_GE(before.bad_fixes, 1);
+  const Outcome checked = replay(s, log, w.map, true, stale_checked);
+  std::cout << "kept to them, lamps where the map has none checked: " << checked.summary() << "\n";
+  EXPECT_EQ(checked.bad_fixes, 0);
 }
 
 // The office's own lamps, three of them out, the start not given: carried at 30 s while the set

@@ -5,6 +5,7 @@
 #include "unmapped_rows.hpp"
 
 #include "edited_map.hpp"
+#include "lampnav/fusion/hypothesis_set.hpp"
 #include "lampnav/graph/geojson.hpp"
 #include "lampnav_test.hpp"
 
@@ -69,6 +70,27 @@ TEST(UnmappedRows, WhatIsNoRowBesideIsNotOne) {
   std::vector<StraySighting> across;
   for (double y : {2.5, 4.75, 7.0}) across.push_back({Eigen::Vector2d(14.0, y), 0.3});
   EXPECT_FALSE(detail::unmapped_row_beside(map, kInC1, across, o));
+}
+
+// The strays of a hypothesis's last images are looked at together, and one lamp seen in several
+// of them is one lamp.
+TEST(UnmappedRows, ALampSeenInSeveralImagesIsOneLamp) {
+  const graph::TopologicalMap map = one_row();
+  const detail::UnmappedRowOptions o;
+  Hypothesis h;
+  h.keep_strays(strays({11.725, 13.975}, 1.8), 4);
+  h.keep_strays(strays({11.75, 14.0}, 1.82), 4);
+  h.keep_strays(strays({11.7}, 1.79), 4);
+  EXPECT_EQ(h.strays.size(), 5u);
+  EXPECT_FALSE(detail::unmapped_row_beside(map, kInC1, h.strays, o));  // two lamps
+  h.keep_strays(strays({16.2}, 1.8), 4);
+  const auto row = detail::unmapped_row_beside(map, kInC1, h.strays, o);
+  ASSERT_TRUE(row.has_value());
+  EXPECT_EQ(row->lamps, 3);
+  // Four images without strays on, all are forgotten.
+  for (int k = 0; k < 4; ++k) h.keep_strays({}, 4);
+  EXPECT_TRUE(h.strays.empty());
+  EXPECT_EQ(h.stray_age.size(), h.strays.size());
 }
 
 }  // namespace

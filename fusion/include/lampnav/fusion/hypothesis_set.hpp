@@ -213,6 +213,23 @@ struct HypothesisSetOptions {
   double row_beside_m = 2.5;
   int row_beside_min_lamps = 3;
   double row_beside_memory_m = 10.0;
+  // The strays of this many omni images (a hypothesis's last) are looked at together: the row's
+  // far lamps are placed too loosely and its near ones often explained, so an image seldom shows
+  // three of them (one or two an image with rows 1.2 m apart).
+  int row_beside_images = 4;
+  // Only strays placed within this (m, StraySighting::reach) count; the row's lamps 5 m along
+  // are placed within about 1 m.
+  double row_beside_reach_m = 1.5;
+  // The leader is not published while this many of the last unexplained_window ceiling frames
+  // that weighed it (at most 32) each held a lamp in full view where it has no map lamp: the
+  // tracking filter's kidnap monitor calls a pose with as many lost (KidnapMonitorOptions,
+  // contradicting_frames of window_frames, 4 of 10), so such a fix would be taken back within a
+  // second, and it is seldom the truth. A wide corridor mapped under one of its rows 1.2 m apart
+  // (the ceiling camera sees the other row whole) made 2 wrong fixes on a drive under the mapped
+  // row, each lost 1.3 s later, into the look-alike corridor 15 m off (docs/hypotheses.md, "A row
+  // the map does not hold"). 0 turns the check off.
+  int publish_unexplained_frames = 4;
+  int unexplained_window = 10;
   // How far the map's lamps may be off the building's (m), in the set's labelling and pose fits:
   // `map build` leaves 2 to 4 cm (docs/mapping.md). The tracking filter keeps the ceiling
   // pipeline's own, tighter, figure.
@@ -272,8 +289,15 @@ struct Hypothesis {
   // birth allowance claim, which floor bumps and the wheels between images exceed.
   bool ceiling_fitted = false;
   const graph::Node* node = nullptr;
-  // The blobs of the last omni image that no lamp explained, placed on the ceiling from it.
+  // The blobs of its last omni images that no lamp explained, each placed on the ceiling from
+  // its image, and how many images ago (0: the last).
   std::vector<StraySighting> strays;
+  std::vector<int> stray_age;
+  // Adds an image's strays, and forgets those of `images` images ago and before.
+  void keep_strays(const std::vector<StraySighting>& latest, int images);
+  // The ceiling frames that weighed it, newest in bit 0: set where a lamp in full view had no map
+  // lamp to be (HypothesisSetOptions::publish_unexplained_frames).
+  std::uint32_t unexplained_frames = 0;
 };
 
 // A row of lamps the omni camera sees that the map does not hold, beside a row it holds.
