@@ -56,9 +56,9 @@ struct HypothesisSet::Impl {
   std::vector<Place> places;
   std::pair<Stamp, Pose2> places_at;  // the capture every place stands at, dead-reckoned pose
   mutable std::map<std::pair<int, int>, bool> twin_cache;  // by hypothesis ids
-  // The last row the map does not hold that an omni image showed beside the leader
-  // (unmapped_rows.hpp), kept until the robot has travelled row_beside_memory_m since: the
-  // leader is not published meanwhile.
+  // The last row the map does not hold that an omni image showed beside one of the likeliest
+  // hypotheses (unmapped_rows.hpp), kept until the robot has travelled row_beside_memory_m
+  // since: no leader is published meanwhile.
   std::optional<UnmappedRow> row_beside;
   Stamp row_seen_at;
 
