@@ -55,9 +55,8 @@ std::optional<UnmappedRow> unmapped_row_beside(const graph::TopologicalMap& map,
   // Each line through two strays: the strays on it, and a mapped row parallel to it beside.
   for (std::size_t i = 0; i < seen.size(); ++i) {
     for (std::size_t j = i + 1; j < seen.size(); ++j) {
-      const Vector2d d = seen[j] - seen[i];
-      if (d.norm() < kLeastOffset) continue;
-      const Vector2d u = d.normalized(), n(-u.y(), u.x());
+      // (Two lamps of `seen` are more than kSameLamp apart: a line through them is defined.)
+      const Vector2d u = (seen[j] - seen[i]).normalized(), n(-u.y(), u.x());
       along.clear();
       for (const Vector2d& p : seen)
         if (std::abs((p - seen[i]).dot(n)) <= o.band_m) along.push_back((p - seen[i]).dot(u));
@@ -82,8 +81,8 @@ std::optional<UnmappedRow> unmapped_row_beside(const graph::TopologicalMap& map,
             t_sum += mapped_t[b];
           }
         if (row_s.size() < 3) continue;
+        // Each offset is within [kLeastOffset, max_offset_m], all on one side: so is their mean.
         const double offset = std::abs(t_sum / static_cast<double>(row_s.size()));
-        if (offset > o.max_offset_m) continue;
         // The longest stretch of strays no further apart than the mapped row's spacing allows.
         const double gap_max = kSpacingRatio * median_gap(row_s);
         std::size_t first = 0;
