@@ -394,8 +394,8 @@ struct HypothesisSet::Impl {
     // (born only within birth_ratio of a best that fits nowhere well), and a complete set never
     // takes a place in again.
     const PoseHypothesis& likeliest = r.hypotheses[best];
-    const bool odd = weigher.misfit(likeliest.score, likeliest.missing, likeliest.unexplained) >
-                     o.odd_image_misfit;
+    const bool odd =
+        weigher.odd(likeliest.score, likeliest.expected, likeliest.missing, likeliest.unexplained);
     const double image_cap = odd ? o.frame_cost_cap : std::numeric_limits<double>::infinity();
     // What the drive said before this image: each hypothesis is born with the cost of the
     // carried place it continues (the least within the gate), so that the places the drive has

@@ -48,6 +48,8 @@ void HypothesisSetOptions::validate() const {
         "must not be negative");
   check(frame_cost_cap > 0, "frame_cost_cap", "must be positive");
   check(odd_image_misfit > 0, "odd_image_misfit", "must be positive");
+  check(odd_image_misfit_per_lamp >= 0 && std::isfinite(odd_image_misfit_per_lamp),
+        "odd_image_misfit_per_lamp", "must be finite and not negative");
   check(odd_image_cost > 0, "odd_image_cost", "must be positive");
   check(contradiction_cost >= 0 && std::isfinite(contradiction_cost), "contradiction_cost",
         "must be finite and not negative");

@@ -109,6 +109,11 @@ double HypothesisWeigher::misfit(double score, int missing, int unexplained) con
   return score - q.miss_cost * missing - q.spurious_cost * unexplained;
 }
 
+bool HypothesisWeigher::odd(double score, int expected, int missing, int unexplained) const {
+  return misfit(score, missing, unexplained) >
+         std::max(o_->odd_image_misfit, o_->odd_image_misfit_per_lamp * (expected - missing));
+}
+
 Weighed HypothesisWeigher::omni(Hypothesis& h, const vision::OmniDetection& d) const {
   const double ps = std::clamp(sigma_position(h.covariance), 0.03, 1.5);
   const double ys = std::clamp(std::sqrt(h.covariance(2, 2)), 0.5 * kDeg, 15 * kDeg);
@@ -133,8 +138,7 @@ Weighed HypothesisWeigher::omni(Hypothesis& h, const vision::OmniDetection& d) c
 Weighed HypothesisWeigher::judged(double cost, double score, int expected, int missing, int seen,
                                   int unexplained) const {
   const bool contradicted = contradicts(expected, missing, seen, unexplained) ||
-                            misfit(score, missing, unexplained) > o_->odd_image_misfit ||
-                            cost > o_->odd_image_cost;
+                            odd(score, expected, missing, unexplained) || cost > o_->odd_image_cost;
   return {contradicted ? cost + o_->contradiction_cost : cost, contradicted};
 }
 

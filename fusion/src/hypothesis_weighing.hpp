@@ -75,6 +75,10 @@ class HypothesisWeigher {
   // unexplained blobs taken out: past HypothesisSetOptions::odd_image_misfit, the image fits
   // the hypothesis nowhere a right place's images were seen to (12.1 at most).
   double misfit(double score, int missing, int unexplained) const;
+  // Whether an image fits the hypothesis as no right place's images were seen to: its misfit past
+  // HypothesisSetOptions::odd_image_misfit, and past odd_image_misfit_per_lamp for each of the
+  // `expected` lamps in clear view it matched (all but `missing`).
+  bool odd(double score, int expected, int missing, int unexplained) const;
 
  private:
   // An omni image's verdict on one hypothesis, from its `cost` after the ledgers, its `score` and

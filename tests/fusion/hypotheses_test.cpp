@@ -215,6 +215,11 @@ TEST(Hypotheses, BadOptionsAreRefusedByName) {
   EXPECT_EQ(refused(o), "");
   o.odd_image_misfit = std::nan("");
   EXPECT_THAT(refused(o), testing::HasSubstr("odd_image_misfit"));
+  for (const double bad : {-0.1, std::nan(""), HUGE_VAL}) {
+    o = {};
+    o.odd_image_misfit_per_lamp = bad;
+    EXPECT_THAT(refused(o), testing::HasSubstr("odd_image_misfit_per_lamp")) << bad;
+  }
   o = {};
   o.odd_image_cost = std::nan("");
   EXPECT_THAT(refused(o), testing::HasSubstr("odd_image_cost"));
