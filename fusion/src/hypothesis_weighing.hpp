@@ -71,20 +71,19 @@ class HypothesisWeigher {
   // before: at most far_stray_cost_max in all, and never less than beyond_map_blob_cost for
   // each of `beyond`.
   double far_charge(double& spent, double far, int beyond) const;
-  // What an omni image's score says of the lamps' directions alone, its missing lamps and
-  // unexplained blobs taken out: past HypothesisSetOptions::odd_image_misfit, the image fits
-  // the hypothesis nowhere a right place's images were seen to (12.1 at most).
-  double misfit(double score, int missing, int unexplained) const;
   // Whether an image fits the hypothesis as no right place's images were seen to: its misfit past
   // HypothesisSetOptions::odd_image_misfit, and past odd_image_misfit_per_lamp for each of the
   // `expected` lamps in clear view it matched (all but `missing`).
   bool odd(double score, int expected, int missing, int unexplained) const;
 
  private:
+  // What an omni image's score says of the lamps' directions alone, its missing lamps and
+  // unexplained blobs taken out: what odd() bounds.
+  double misfit(double score, int missing, int unexplained) const;
   // An omni image's verdict on one hypothesis, from its `cost` after the ledgers, its `score` and
   // its counts (`seen`: blobs matched or unexplained): contradicted when most lamps expected in
-  // clear view are unseen or most blobs unexplained, when the lamps' directions misfit past
-  // HypothesisSetOptions::odd_image_misfit, or when the cost passes odd_image_cost. A
+  // clear view are unseen or most blobs unexplained, when the image is odd() for it, or when the
+  // cost passes HypothesisSetOptions::odd_image_cost. A
   // contradiction is charged as the evidence it is (contradiction_cost).
   Weighed judged(double cost, double score, int expected, int missing, int seen,
                  int unexplained) const;

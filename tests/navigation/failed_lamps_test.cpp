@@ -267,11 +267,8 @@ TEST(FailedLampsAndCarries, AnImageOfManyLampsIsNotOddForMatchingThemAll) {
         "failed_lamps_two_rows.mcap",
         [](sim::Scenario& s) {
           s.kidnaps = {{20, std::nullopt}, {45, std::nullopt}, {70, std::nullopt}};
+          as_seed_86_drove(s, 60);  // the twin was published at 51.5 s
           s.bump_sigma_rad = 1.2 * M_PI / 180;
-          s.odometry.left_scale = -0.01;
-          s.odometry.right_scale = 0.008;
-          s.ceiling_delay_s = 1.5;
-          s.max_duration_s = 60;  // the twin was published at 51.5 s
         },
         o);
   };
