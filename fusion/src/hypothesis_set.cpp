@@ -170,13 +170,15 @@ struct HypothesisSet::Impl {
     }
     std::vector<detail::Weighed> weighed(next.size());
     // Three or fewer stay on this thread: starting one costs about what weighing one does.
+    // `next` is in the order of `hs`, likeliest first (tidy()): weigh() is told each one's rank.
     for_each_costly_index(next.size(), o.weigh_in_parallel ? 3 : next.size(),
-                          [&](std::size_t k) { weighed[k] = weigh(next[k]); });
+                          [&](std::size_t k) { weighed[k] = weigh(next[k], k); });
     bool all_contradicted = true;
     double best = std::numeric_limits<double>::infinity();
     for (const detail::Weighed& w : weighed) {
       all_contradicted = all_contradicted && w.contradicted.value_or(false);
       best = std::min(best, w.cost);
+      counts.moved_by_search += w.moved;
     }
     for (std::size_t k = 0; k < next.size(); ++k) {
       next[k].last_cost = weighed[k].cost;
@@ -555,9 +557,11 @@ void HypothesisSet::omni(Stamp stamp, const vision::OmniDetection& d,
                        [](const Hypothesis& h) { return h.origin != HypothesisOrigin::kept; }),
         m.hs.end());
   if (!m.hs.empty()) {
-    const bool all_contradicted =
-        m.weigh_all(stamp, odometry, m.o.frame_cost_cap, m.o.omni_tie_cost,
-                    [&](Hypothesis& h) { return m.weigher.omni(h, d); });
+    const bool all_contradicted = m.weigh_all(
+        stamp, odometry, m.o.frame_cost_cap, m.o.omni_tie_cost,
+        [&](Hypothesis& h, std::size_t rank) {
+          return m.weigher.omni(h, d, rank < std::size_t(m.o.odd_image_search_hypotheses));
+        });
     if (m.complete) ++m.omni_frames;
     m.note_travel(stamp, odometry);
     m.tidy();
@@ -580,7 +584,7 @@ void HypothesisSet::ceiling(Stamp stamp, const std::vector<vision::LampDetection
   // Until the places are all known the omni frames do the weighing (see omni()).
   if (!m.weigher.weighs_ceiling() || m.hs.empty() || !m.complete) return;
   m.weigh_all(stamp, odometry, m.o.ceiling_cost_cap, 0.0,
-              [&](Hypothesis& h) { return m.weigher.ceiling(h, lamps); });
+              [&](Hypothesis& h, std::size_t) { return m.weigher.ceiling(h, lamps); });
   m.note_travel(stamp, odometry);
   m.tidy();
   if (m.complete && m.hs.empty()) m.reset("every hypothesis went through a wall");

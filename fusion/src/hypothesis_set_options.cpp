@@ -50,6 +50,11 @@ void HypothesisSetOptions::validate() const {
   check(odd_image_misfit > 0, "odd_image_misfit", "must be positive");
   check(odd_image_misfit_per_lamp >= 0 && std::isfinite(odd_image_misfit_per_lamp),
         "odd_image_misfit_per_lamp", "must be finite and not negative");
+  check(odd_image_search_m >= 0 && odd_image_search_m <= 5, "odd_image_search_m",
+        "must be 0 to 5 m");
+  check(odd_image_search_deg > 0 && odd_image_search_deg <= 45, "odd_image_search_deg",
+        "must be more than 0 and at most 45 degrees");
+  check(odd_image_search_hypotheses >= 1, "odd_image_search_hypotheses", "must be at least 1");
   check(odd_image_cost > 0, "odd_image_cost", "must be positive");
   check(contradiction_cost >= 0 && std::isfinite(contradiction_cost), "contradiction_cost",
         "must be finite and not negative");

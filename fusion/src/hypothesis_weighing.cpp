@@ -114,20 +114,54 @@ bool HypothesisWeigher::odd(double score, int expected, int missing, int unexpla
          std::max(o_->odd_image_misfit, o_->odd_image_misfit_per_lamp * (expected - missing));
 }
 
-Weighed HypothesisWeigher::omni(Hypothesis& h, const vision::OmniDetection& d) const {
+std::optional<PoseHypothesis> HypothesisWeigher::fit_nearby(const Pose2& at,
+                                                            const PoseHypothesis& odd_fit,
+                                                            const vision::OmniDetection& d) const {
+  EnumerationPrior near;
+  near.poses = {at};
+  near.gate_m = o_->odd_image_search_m;
+  near.gate_rad = o_->odd_image_search_deg * kDeg;
+  // Within a gate this small a handful of poses is plenty: the best 8, from the candidates
+  // screened within 10 (and the search's own 30) of the best.
+  GlobalLocalization found = omni_->enumerate(d, 8, 10.0, &near);
+  for (PoseHypothesis& c : found.hypotheses)
+    if (c.matches.size() >= 2 && c.score < odd_fit.score && !odd(c)) return std::move(c);
+  return std::nullopt;
+}
+
+Weighed HypothesisWeigher::omni(Hypothesis& h, const vision::OmniDetection& d,
+                                bool may_search) const {
   const double ps = std::clamp(sigma_position(h.covariance), 0.03, 1.5);
   const double ys = std::clamp(std::sqrt(h.covariance(2, 2)), 0.5 * kDeg, 15 * kDeg);
-  const std::optional<PoseHypothesis> r = omni_->refine(h.pose, ps, ys, d);
+  std::optional<PoseHypothesis> r = omni_->refine(h.pose, ps, ys, d);
   if (r && r->matches.size() >= 2) {
+    bool moved = false;
+    if (may_search && o_->odd_image_search_m > 0 && odd(*r))
+      if (std::optional<PoseHypothesis> c = fit_nearby(h.pose, *r, d)) {
+        r = std::move(c);
+        moved = true;
+      }
     Eigen::Matrix3d R = r->covariance;
     R.diagonal() += Eigen::Vector3d(o_->omni_bump_sigma_m * o_->omni_bump_sigma_m,
                                     o_->omni_bump_sigma_m * o_->omni_bump_sigma_m,
                                     std::pow(o_->omni_bump_sigma_deg * kDeg, 2));
+    // Moved, the hypothesis is where the image puts it, as sure of it as the image is; the
+    // odometry that carried it there is not charged for the move (the search's gate bounds it).
+    double innovation = 0;
+    if (moved) {
+      h.pose = r->pose;
+      h.covariance = R;
+    } else {
+      innovation = std::max(0.0, update(h, r->pose, R));
+    }
     const int seen = static_cast<int>(r->matches.size()) + r->unexplained;
     // A misfit better than expected says nothing (map_evidence.hpp, charge_misfit).
-    return judged(r->score + charge_image(h, r->missed, r->unexplained, r->strays, r->lamp_costs) +
-                      std::max(0.0, update(h, r->pose, R)),
-                  r->score, r->expected, r->missing, seen, r->unexplained);
+    Weighed w =
+        judged(r->score + charge_image(h, r->missed, r->unexplained, r->strays, r->lamp_costs) +
+                   innovation,
+               r->score, r->expected, r->missing, seen, r->unexplained);
+    w.moved = moved;
+    return w;
   }
   // Nothing to refine on: the prediction scored as it stands, with its own uncertainty.
   const GlobalLocalizer::PoseScore sc = omni_->score(h.pose, ps, ys, d);

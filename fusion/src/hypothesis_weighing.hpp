@@ -24,6 +24,7 @@ namespace lampnav::fusion::detail {
 struct Weighed {
   double cost = 0;
   std::optional<bool> contradicted;
+  bool moved = false;  // to a pose near it that the image fits (HypothesisWeigher::omni)
 };
 
 class HypothesisWeigher {
@@ -36,8 +37,10 @@ class HypothesisWeigher {
 
   bool weighs_ceiling() const { return labeller_.has_value(); }
 
-  // An omni frame for one hypothesis (carried to the frame), updating it.
-  Weighed omni(Hypothesis& h, const vision::OmniDetection& d) const;
+  // An omni frame for one hypothesis (carried to the frame), updating it. With `may_search`,
+  // an image odd at the pose the refinement reached is searched for near the hypothesis
+  // (HypothesisSetOptions::odd_image_search_m), and a pose there that it fits moves it.
+  Weighed omni(Hypothesis& h, const vision::OmniDetection& d, bool may_search) const;
   // A ceiling frame for one hypothesis (carried to the frame), updating it.
   Weighed ceiling(Hypothesis& h, const std::vector<vision::LampDetection>& lamps) const;
 
@@ -75,8 +78,15 @@ class HypothesisWeigher {
   // HypothesisSetOptions::odd_image_misfit, and past odd_image_misfit_per_lamp for each of the
   // `expected` lamps in clear view it matched (all but `missing`).
   bool odd(double score, int expected, int missing, int unexplained) const;
+  bool odd(const PoseHypothesis& p) const {
+    return odd(p.score, p.expected, p.missing, p.unexplained);
+  }
 
  private:
+  // The best pose within odd_image_search_m and odd_image_search_deg of `at` that the image
+  // allows, scores better than `odd_fit` and is not odd; nullopt when there is none.
+  std::optional<PoseHypothesis> fit_nearby(const Pose2& at, const PoseHypothesis& odd_fit,
+                                           const vision::OmniDetection& d) const;
   // What an omni image's score says of the lamps' directions alone, its missing lamps and
   // unexplained blobs taken out: what odd() bounds.
   double misfit(double score, int missing, int unexplained) const;

@@ -220,6 +220,22 @@ TEST(Hypotheses, BadOptionsAreRefusedByName) {
     o.odd_image_misfit_per_lamp = bad;
     EXPECT_THAT(refused(o), testing::HasSubstr("odd_image_misfit_per_lamp")) << bad;
   }
+  for (const double bad : {-0.1, 5.5, std::nan(""), HUGE_VAL}) {
+    o = {};
+    o.odd_image_search_m = bad;
+    EXPECT_THAT(refused(o), testing::HasSubstr("odd_image_search_m")) << bad;
+  }
+  for (const double bad : {0.0, 46.0, std::nan("")}) {
+    o = {};
+    o.odd_image_search_deg = bad;
+    EXPECT_THAT(refused(o), testing::HasSubstr("odd_image_search_deg")) << bad;
+  }
+  o = {};
+  o.odd_image_search_hypotheses = 0;
+  EXPECT_THAT(refused(o), testing::HasSubstr("odd_image_search_hypotheses"));
+  o = {};
+  o.odd_image_search_m = 0;  // the search off
+  EXPECT_EQ(refused(o), "");
   o = {};
   o.odd_image_cost = std::nan("");
   EXPECT_THAT(refused(o), testing::HasSubstr("odd_image_cost"));
