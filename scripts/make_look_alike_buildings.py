@@ -8,8 +8,8 @@ corridor's axis, one over each junction, corner and end.
 
     scripts/make_look_alike_buildings.py OUT_DIR
 
-writes square_ring.geojson, hexagon_hub.geojson, comb_60.geojson and oblique_lattice.geojson (the
-last is tests/fixtures/maps/oblique_lattice.geojson). Each passes `lampnav map check`.
+writes square_ring.geojson, hexagon_hub.geojson, comb_60.geojson and oblique_lattice.geojson.
+Each passes `lampnav map check`.
 """
 import json, math, os, sys
 OUT = sys.argv[1] if len(sys.argv) > 1 else "."

@@ -135,20 +135,39 @@ Weighed HypothesisWeigher::omni(Hypothesis& h, const vision::OmniDetection& d,
   const double ys = std::clamp(std::sqrt(h.covariance(2, 2)), 0.5 * kDeg, 15 * kDeg);
   std::optional<PoseHypothesis> r = omni_->refine(h.pose, ps, ys, d);
   if (r && r->matches.size() >= 2) {
+    const auto measurement_covariance = [&](const PoseHypothesis& p) {
+      Eigen::Matrix3d R = p.covariance;
+      R.diagonal() += Eigen::Vector3d(o_->omni_bump_sigma_m * o_->omni_bump_sigma_m,
+                                      o_->omni_bump_sigma_m * o_->omni_bump_sigma_m,
+                                      std::pow(o_->omni_bump_sigma_deg * kDeg, 2));
+      return R;
+    };
+    // A pose nearby that the image fits moves the hypothesis only when the move is likelier
+    // for it than the contradiction it replaces (its innovation under the hypothesis's
+    // covariance less than contradiction_cost): the search mends a refinement that settled
+    // beside the truth, not a hypothesis that is truly off. Moves past that, tried, rescued a
+    // look-alike place and its twin alike after a carry (no image then contradicted them all,
+    // and the set, not started again, published the wrong one).
     bool moved = false;
+    double move_cost = 0;
     if (may_search && o_->odd_image_search_m > 0 && odd(*r))
       if (std::optional<PoseHypothesis> c = fit_nearby(h.pose, *r, d)) {
-        r = std::move(c);
-        moved = true;
+        Pose2 pose = h.pose;
+        Eigen::Matrix3d P = h.covariance;
+        move_cost = std::max(0.0, update_pose(pose, P, c->pose, measurement_covariance(*c),
+                                              o_->sigma_m, o_->sigma_yaw_deg * kDeg));
+        if (move_cost < o_->contradiction_cost) {
+          r = std::move(c);
+          moved = true;
+        }
       }
-    Eigen::Matrix3d R = r->covariance;
-    R.diagonal() += Eigen::Vector3d(o_->omni_bump_sigma_m * o_->omni_bump_sigma_m,
-                                    o_->omni_bump_sigma_m * o_->omni_bump_sigma_m,
-                                    std::pow(o_->omni_bump_sigma_deg * kDeg, 2));
-    // Moved, the hypothesis is where the image puts it, as sure of it as the image is; the
-    // odometry that carried it there is not charged for the move (the search's gate bounds it).
+    const Eigen::Matrix3d R = measurement_covariance(*r);
+    // Moved, the hypothesis is where the image puts it, as sure of it as the image is, and the
+    // move is charged as the Kalman update's innovation would be: a look-alike place moved onto
+    // a pose that fits must not gain on one the images fitted all along.
     double innovation = 0;
     if (moved) {
+      innovation = move_cost;
       h.pose = r->pose;
       h.covariance = R;
     } else {
