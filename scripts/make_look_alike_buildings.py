@@ -13,9 +13,16 @@ Each passes `lampnav map check`.
 """
 import json, math, os, sys
 OUT = sys.argv[1] if len(sys.argv) > 1 else "."
+os.makedirs(OUT, exist_ok=True)
 
 
 def build(name, nodes, corridors, spacing, height, R=2.5, w=2.0, size=(1.2, 0.3)):
+    """A lampnav map (docs: spec map-format.md) of `nodes` (name -> (place kind, (x, y))) joined
+    by straight `corridors` (pairs of names). Each place is a 12-gon of radius R with one lamp over
+    its point; each corridor a node of its own, its region a rectangle w wide from R past its
+    first place to R short of its second (so regions only touch, whatever the angle between
+    corridors, down to 45 degrees), its lamps `spacing` apart counted from its first place, along
+    its axis. Edges run both ways, place to corridor to place."""
     feats = []; fid = [1]; eid = [5000]
     pos = {n: p for n, (k, p) in nodes.items()}
     ids = {}
