@@ -11,59 +11,62 @@ corridor's axis, one over each junction, corner and end.
 writes square_ring.geojson, hexagon_hub.geojson, comb_60.geojson and oblique_lattice.geojson.
 Each passes `lampnav map check`.
 """
-import json, math, os, sys
+import math
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from make_maps import MapBuilder  # noqa: E402
+
 OUT = sys.argv[1] if len(sys.argv) > 1 else "."
 os.makedirs(OUT, exist_ok=True)
 
 
+def polygon(cx, cy, r, k=12):
+    return [(cx + r * math.cos(2 * math.pi * (i + 0.5) / k),
+             cy + r * math.sin(2 * math.pi * (i + 0.5) / k)) for i in range(k)]
+
+
+def lamp(lid, x, y, height, yaw, size):
+    return {"id": lid, "xyz": [round(x, 6), round(y, 6), height], "yaw": round(yaw % math.pi, 7),
+            "shape": "rectangle", "size": list(size)}
+
+
 def build(name, nodes, corridors, spacing, height, R=2.5, w=2.0, size=(1.2, 0.3)):
-    """A lampnav map (docs: spec map-format.md) of `nodes` (name -> (place kind, (x, y))) joined
+    """A lampnav map (the spec's map-format.md) of `nodes` (name -> (place kind, (x, y))) joined
     by straight `corridors` (pairs of names). Each place is a 12-gon of radius R with one lamp over
     its point; each corridor a node of its own, its region a rectangle w wide from R past its
     first place to R short of its second (so regions only touch, whatever the angle between
     corridors, down to 45 degrees), its lamps `spacing` apart counted from its first place, along
     its axis. Edges run both ways, place to corridor to place."""
-    feats = []; fid = [1]; eid = [5000]
+    m = MapBuilder(name)
     pos = {n: p for n, (k, p) in nodes.items()}
-    ids = {}
-    def poly(cx, cy, r, k=12):
-        return {"x_values": [round(cx + r*math.cos(2*math.pi*i/k + math.pi/k), 6) for i in range(k)],
-                "y_values": [round(cy + r*math.sin(2*math.pi*i/k + math.pi/k), 6) for i in range(k)]}
     yaw_of = {}
     for a, b in corridors:
-        for n, m in ((a, b), (b, a)):
-            yaw_of.setdefault(n, math.atan2(pos[m][1]-pos[n][1], pos[m][0]-pos[n][0]))
+        for n, o in ((a, b), (b, a)):
+            yaw_of.setdefault(n, math.atan2(pos[o][1] - pos[n][1], pos[o][0] - pos[n][0]))
     for n, (k, p) in nodes.items():
-        ids[n] = fid[0]; fid[0] += 1
-        feats.append({"type": "Feature", "geometry": {"type": "Point", "coordinates": list(p)},
-            "properties": {"id": ids[n], "frame": "map", "metadata": {"name": n, "place": k, "region": poly(p[0], p[1], R)},
-            "lampnav": {"lamps": [{"id": n+"-L1", "xyz": [p[0], p[1], height], "yaw": round(yaw_of[n] % math.pi, 7), "shape": "rectangle", "size": list(size)}]}}})
-    edges = []
+        m.node(n, k, p, polygon(p[0], p[1], R), lamps=[lamp(n + "-L1", p[0], p[1], height,
+                                                           yaw_of[n], size)])
     for ci, (a, b) in enumerate(corridors):
-        pa, pb = pos[a], pos[b]; L = math.dist(pa, pb)
-        ux, uy = (pb[0]-pa[0])/L, (pb[1]-pa[1])/L; nx, ny = -uy, ux
-        s0, s1 = R, L - R
-        P = lambda t, o=0: (pa[0]+ux*t+nx*o, pa[1]+uy*t+ny*o)
-        cn = f"C{ci+1}"; mid = P(L/2)
-        region = [P(s0, -w/2), P(s1, -w/2), P(s1, w/2), P(s0, w/2)]
-        lamps = []; k = 1
-        while k*spacing < s1 - 0.3:
-            t = k*spacing
-            if t > s0 + 0.3:
-                x, y = P(t); lamps.append({"id": f"{cn}-L{len(lamps)+1}", "xyz": [round(x, 6), round(y, 6), height], "yaw": round(math.atan2(uy, ux) % math.pi, 7), "shape": "rectangle", "size": list(size)})
-            k += 1
-        ids[cn] = fid[0]; fid[0] += 1
-        feats.append({"type": "Feature", "geometry": {"type": "Point", "coordinates": [round(mid[0], 6), round(mid[1], 6)]},
-            "properties": {"id": ids[cn], "frame": "map", "metadata": {"name": cn, "place": "corridor",
-              "region": {"x_values": [round(q[0], 6) for q in region], "y_values": [round(q[1], 6) for q in region]},
-              "axis": {"x_values": [round(P(s0)[0], 6), round(P(s1)[0], 6)], "y_values": [round(P(s0)[1], 6), round(P(s1)[1], 6)]}, "width": w},
-              "lampnav": {"lamps": lamps}}})
-        for u, v in ((a, cn), (cn, b)):
-            pu = pos[u] if u in pos else mid; pv = pos[v] if v in pos else mid
-            for s, e, ps, pe in ((u, v, pu, pv), (v, u, pv, pu)):
-                edges.append({"type": "Feature", "geometry": {"type": "MultiLineString", "coordinates": [[[round(ps[0], 6), round(ps[1], 6)], [round(pe[0], 6), round(pe[1], 6)]]]},
-                              "properties": {"id": eid[0], "startid": ids[s], "endid": ids[e], "metadata": {}}}); eid[0] += 1
-    return {"type": "FeatureCollection", "name": name, "lampnav": {"format": 2, "units": "m", "frame": "map"}, "features": feats + edges}
+        pa, pb = pos[a], pos[b]
+        L = math.dist(pa, pb)
+        ux, uy = (pb[0] - pa[0]) / L, (pb[1] - pa[1]) / L
+
+        def at(t, off=0.0):
+            return (pa[0] + ux * t - uy * off, pa[1] + uy * t + ux * off)
+
+        cn = f"C{ci + 1}"
+        lamps = [lamp(f"{cn}-L{i + 1}", *at(t), height, math.atan2(uy, ux), size)
+                 for i, t in enumerate(t for t in (k * spacing for k in range(1, int(L / spacing) + 1))
+                                       if R + 0.3 < t < L - R - 0.3)]
+        mid = at(L / 2)
+        m.node(cn, "corridor", mid, [at(R, -w / 2), at(L - R, -w / 2), at(L - R, w / 2), at(R, w / 2)],
+               axis=(at(R), at(L - R)), width=w, lamps=lamps)
+        m.edge(a, cn, [pa, mid])
+        m.edge(cn, b, [mid, pb])
+    return m
+
 
 def kind(deg):
     return {1: "end", 2: "corner"}.get(deg, "junction")
@@ -71,9 +74,8 @@ def finish(name, pts, cors, spacing, height, **kw):
     deg = {}
     for a, b in cors: deg[a] = deg.get(a, 0)+1; deg[b] = deg.get(b, 0)+1
     nodes = {n: (kind(deg[n]), p) for n, p in pts.items()}
-    with open(os.path.join(OUT, name + ".geojson"), "w") as f:
-        json.dump(build(name.replace("_", " "), nodes, cors, spacing, height, **kw), f, indent=1)
-        f.write("\n")
+    build(name.replace("_", " "), nodes, cors, spacing, height, **kw).write(
+        os.path.join(OUT, name + ".geojson"))
 
 # r1: a square ring with spurs outward (4-fold symmetric)
 pts = {"K1": (0, 0), "J1": (16, 0), "K2": (32, 0), "J2": (32, 16), "K3": (32, 32), "J3": (16, 32), "K4": (0, 32), "J4": (0, 16),

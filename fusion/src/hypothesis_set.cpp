@@ -178,7 +178,6 @@ struct HypothesisSet::Impl {
     for (const detail::Weighed& w : weighed) {
       all_contradicted = all_contradicted && w.contradicted.value_or(false);
       best = std::min(best, w.cost);
-      counts.moved_by_search += w.moved;
     }
     for (std::size_t k = 0; k < next.size(); ++k) {
       next[k].last_cost = weighed[k].cost;

@@ -114,18 +114,38 @@ bool HypothesisWeigher::odd(double score, int expected, int missing, int unexpla
          std::max(o_->odd_image_misfit, o_->odd_image_misfit_per_lamp * (expected - missing));
 }
 
-std::optional<PoseHypothesis> HypothesisWeigher::fit_nearby(const Pose2& at,
-                                                            const PoseHypothesis& odd_fit,
-                                                            const vision::OmniDetection& d) const {
+Eigen::Matrix3d HypothesisWeigher::measurement_covariance(const PoseHypothesis& p) const {
+  Eigen::Matrix3d R = p.covariance;
+  R.diagonal() += Eigen::Vector3d(o_->omni_bump_sigma_m * o_->omni_bump_sigma_m,
+                                  o_->omni_bump_sigma_m * o_->omni_bump_sigma_m,
+                                  std::pow(o_->omni_bump_sigma_deg * kDeg, 2));
+  return R;
+}
+
+std::optional<std::pair<PoseHypothesis, double>> HypothesisWeigher::move_nearby(
+    const Hypothesis& h, const PoseHypothesis& odd_fit, const vision::OmniDetection& d) const {
   EnumerationPrior near;
-  near.poses = {at};
+  near.poses = {h.pose};
   near.gate_m = o_->odd_image_search_m;
   near.gate_rad = o_->odd_image_search_deg * kDeg;
   // Within a gate this small a handful of poses is plenty: the best 8, from the candidates
   // screened within 10 (and the search's own 30) of the best.
   GlobalLocalization found = omni_->enumerate(d, 8, 10.0, &near);
-  for (PoseHypothesis& c : found.hypotheses)
-    if (c.matches.size() >= 2 && c.score < odd_fit.score && !odd(c)) return std::move(c);
+  for (PoseHypothesis& c : found.hypotheses) {
+    if (c.matches.size() < 2 || !(c.score < odd_fit.score) || odd(c)) continue;
+    // The best such pose only, and only when the move is likelier for the hypothesis than the
+    // contradiction it replaces (its innovation under the hypothesis's covariance less than
+    // contradiction_cost): the search mends a refinement that settled beside the truth, not a
+    // hypothesis that is truly off. Moves past that, tried, rescued a look-alike place and its
+    // twin alike after a carry (no image then contradicted them all, and the set, not started
+    // again, published the wrong one).
+    Pose2 pose = h.pose;
+    Eigen::Matrix3d P = h.covariance;
+    const double cost = std::max(0.0, update_pose(pose, P, c.pose, measurement_covariance(c),
+                                                  o_->sigma_m, o_->sigma_yaw_deg * kDeg));
+    if (cost >= o_->contradiction_cost) return std::nullopt;
+    return std::make_pair(std::move(c), cost);
+  }
   return std::nullopt;
 }
 
@@ -135,39 +155,19 @@ Weighed HypothesisWeigher::omni(Hypothesis& h, const vision::OmniDetection& d,
   const double ys = std::clamp(std::sqrt(h.covariance(2, 2)), 0.5 * kDeg, 15 * kDeg);
   std::optional<PoseHypothesis> r = omni_->refine(h.pose, ps, ys, d);
   if (r && r->matches.size() >= 2) {
-    const auto measurement_covariance = [&](const PoseHypothesis& p) {
-      Eigen::Matrix3d R = p.covariance;
-      R.diagonal() += Eigen::Vector3d(o_->omni_bump_sigma_m * o_->omni_bump_sigma_m,
-                                      o_->omni_bump_sigma_m * o_->omni_bump_sigma_m,
-                                      std::pow(o_->omni_bump_sigma_deg * kDeg, 2));
-      return R;
-    };
-    // A pose nearby that the image fits moves the hypothesis only when the move is likelier
-    // for it than the contradiction it replaces (its innovation under the hypothesis's
-    // covariance less than contradiction_cost): the search mends a refinement that settled
-    // beside the truth, not a hypothesis that is truly off. Moves past that, tried, rescued a
-    // look-alike place and its twin alike after a carry (no image then contradicted them all,
-    // and the set, not started again, published the wrong one).
-    bool moved = false;
-    double move_cost = 0;
+    std::optional<double> move_cost;
     if (may_search && o_->odd_image_search_m > 0 && odd(*r))
-      if (std::optional<PoseHypothesis> c = fit_nearby(h.pose, *r, d)) {
-        Pose2 pose = h.pose;
-        Eigen::Matrix3d P = h.covariance;
-        move_cost = std::max(0.0, update_pose(pose, P, c->pose, measurement_covariance(*c),
-                                              o_->sigma_m, o_->sigma_yaw_deg * kDeg));
-        if (move_cost < o_->contradiction_cost) {
-          r = std::move(c);
-          moved = true;
-        }
+      if (auto moved = move_nearby(h, *r, d)) {
+        r = std::move(moved->first);
+        move_cost = moved->second;
       }
     const Eigen::Matrix3d R = measurement_covariance(*r);
     // Moved, the hypothesis is where the image puts it, as sure of it as the image is, and the
     // move is charged as the Kalman update's innovation would be: a look-alike place moved onto
     // a pose that fits must not gain on one the images fitted all along.
     double innovation = 0;
-    if (moved) {
-      innovation = move_cost;
+    if (move_cost) {
+      innovation = *move_cost;
       h.pose = r->pose;
       h.covariance = R;
     } else {
@@ -175,12 +175,9 @@ Weighed HypothesisWeigher::omni(Hypothesis& h, const vision::OmniDetection& d,
     }
     const int seen = static_cast<int>(r->matches.size()) + r->unexplained;
     // A misfit better than expected says nothing (map_evidence.hpp, charge_misfit).
-    Weighed w =
-        judged(r->score + charge_image(h, r->missed, r->unexplained, r->strays, r->lamp_costs) +
-                   innovation,
-               r->score, r->expected, r->missing, seen, r->unexplained);
-    w.moved = moved;
-    return w;
+    return judged(r->score + charge_image(h, r->missed, r->unexplained, r->strays, r->lamp_costs) +
+                      innovation,
+                  r->score, r->expected, r->missing, seen, r->unexplained);
   }
   // Nothing to refine on: the prediction scored as it stands, with its own uncertainty.
   const GlobalLocalizer::PoseScore sc = omni_->score(h.pose, ps, ys, d);

@@ -24,7 +24,6 @@ namespace lampnav::fusion::detail {
 struct Weighed {
   double cost = 0;
   std::optional<bool> contradicted;
-  bool moved = false;  // to a pose near it that the image fits (HypothesisWeigher::omni)
 };
 
 class HypothesisWeigher {
@@ -83,10 +82,14 @@ class HypothesisWeigher {
   }
 
  private:
-  // The best pose within odd_image_search_m and odd_image_search_deg of `at` that the image
-  // allows, scores better than `odd_fit` and is not odd; nullopt when there is none.
-  std::optional<PoseHypothesis> fit_nearby(const Pose2& at, const PoseHypothesis& odd_fit,
-                                           const vision::OmniDetection& d) const;
+  // The covariance of the pose an omni image measures: its least squares' and the floor's bumps
+  // (omni_bump_sigma_m, omni_bump_sigma_deg).
+  Eigen::Matrix3d measurement_covariance(const PoseHypothesis& p) const;
+  // The best pose within odd_image_search_m and odd_image_search_deg of `h` that the image
+  // allows, scores better than `odd_fit` and is not odd, with what moving `h` there costs it;
+  // nullopt when there is none, or when the move costs more than a contradiction.
+  std::optional<std::pair<PoseHypothesis, double>> move_nearby(
+      const Hypothesis& h, const PoseHypothesis& odd_fit, const vision::OmniDetection& d) const;
   // What an omni image's score says of the lamps' directions alone, its missing lamps and
   // unexplained blobs taken out: what odd() bounds.
   double misfit(double score, int missing, int unexplained) const;

@@ -383,10 +383,9 @@ class HypothesisSet {
   struct Counts {
     std::uint64_t born = 0, merged = 0, through_walls = 0, dropped = 0, resets = 0,
                   enumerations = 0, complete_enumerations = 0;
-    std::uint64_t place_restarts = 0;   // the places the drive allowed all lost: started again
-    std::uint64_t stale_places = 0;     // an image alone far likelier elsewhere: started again
-    std::uint64_t unmapped_rows = 0;    // omni frames whose leader saw an unmapped row beside
-    std::uint64_t moved_by_search = 0;  // odd images a nearby pose fitted (odd_image_search_m)
+    std::uint64_t place_restarts = 0;  // the places the drive allowed all lost: started again
+    std::uint64_t stale_places = 0;    // an image alone far likelier elsewhere: started again
+    std::uint64_t unmapped_rows = 0;   // omni frames whose leader saw an unmapped row beside
   };
   const Counts& counts() const;
   const HypothesisSetOptions& options() const;
