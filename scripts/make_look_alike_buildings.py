@@ -8,11 +8,14 @@ corridor's axis, one over each junction, corner and end.
 
     scripts/make_look_alike_buildings.py OUT_DIR
 
-writes square_ring.geojson, hexagon_hub.geojson, comb_60.geojson and oblique_lattice.geojson.
+writes square_ring.geojson, hexagon_hub.geojson, comb_60.geojson and oblique_lattice.geojson,
+and two grids whose corridors each have their own lamps (mixed_grid.geojson,
+mixed_uneven_grid.geojson; docs/hypotheses.md, "Corridors each of their own").
 Each passes `lampnav map check`.
 """
 import math
 import os
+import random
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -28,17 +31,24 @@ def polygon(cx, cy, r, k=12):
 
 
 def lamp(lid, x, y, height, yaw, size):
+    """A rectangle `size` (length, width), or a disc when `size` has one number (its diameter)."""
+    if len(size) == 1:
+        return {"id": lid, "xyz": [round(x, 6), round(y, 6), height], "shape": "disc",
+                "size": list(size)}
     return {"id": lid, "xyz": [round(x, 6), round(y, 6), height], "yaw": round(yaw % math.pi, 7),
             "shape": "rectangle", "size": list(size)}
 
 
-def build(name, nodes, corridors, spacing, height, R=2.5, w=2.0, size=(1.2, 0.3)):
+def build(name, nodes, corridors, spacing, height, R=2.5, w=2.0, size=(1.2, 0.3), style=None,
+          place_height=None):
     """A lampnav map (the spec's map-format.md) of `nodes` (name -> (place kind, (x, y))) joined
     by straight `corridors` (pairs of names). Each place is a 12-gon of radius R with one lamp over
     its point; each corridor a node of its own, its region a rectangle w wide from R past its
     first place to R short of its second (so regions only touch, whatever the angle between
     corridors, down to 45 degrees), its lamps `spacing` apart counted from its first place, along
-    its axis. Edges run both ways, place to corridor to place."""
+    its axis. Edges run both ways, place to corridor to place. `style(k)`, when given, returns
+    corridor k's own (height, spacing, size, offset of its row off the axis, first lamp's
+    distance from its first place); `place_height(name)` a place's lamp's height."""
     m = MapBuilder(name)
     pos = {n: p for n, (k, p) in nodes.items()}
     yaw_of = {}
@@ -46,7 +56,8 @@ def build(name, nodes, corridors, spacing, height, R=2.5, w=2.0, size=(1.2, 0.3)
         for n, o in ((a, b), (b, a)):
             yaw_of.setdefault(n, math.atan2(pos[o][1] - pos[n][1], pos[o][0] - pos[n][0]))
     for n, (k, p) in nodes.items():
-        m.node(n, k, p, polygon(p[0], p[1], R), lamps=[lamp(n + "-L1", p[0], p[1], height,
+        h = place_height(n) if place_height else height
+        m.node(n, k, p, polygon(p[0], p[1], R), lamps=[lamp(n + "-L1", p[0], p[1], h,
                                                            yaw_of[n], size)])
     for ci, (a, b) in enumerate(corridors):
         pa, pb = pos[a], pos[b]
@@ -57,8 +68,9 @@ def build(name, nodes, corridors, spacing, height, R=2.5, w=2.0, size=(1.2, 0.3)
             return (pa[0] + ux * t - uy * off, pa[1] + uy * t + ux * off)
 
         cn = f"C{ci + 1}"
-        lamps = [lamp(f"{cn}-L{i + 1}", *at(t), height, math.atan2(uy, ux), size)
-                 for i, t in enumerate(t for t in (k * spacing for k in range(1, int(L / spacing) + 1))
+        h, sp, sz, off, first = style(ci) if style else (height, spacing, size, 0.0, spacing)
+        lamps = [lamp(f"{cn}-L{i + 1}", *at(t, off), h, math.atan2(uy, ux), sz)
+                 for i, t in enumerate(t for t in (first + k * sp for k in range(int(L / sp) + 1))
                                        if R + 0.3 < t < L - R - 0.3)]
         mid = at(L / 2)
         m.node(cn, "corridor", mid, [at(R, -w / 2), at(L - R, -w / 2), at(L - R, w / 2), at(R, w / 2)],
@@ -105,3 +117,31 @@ for i in range(3):
         pts[f"P{i}_{j}"] = (round(16*i + 8*j, 6), round(16*math.sin(math.radians(60))*j, 6))
 cors = [(f"P{i}_{j}", f"P{i+1}_{j}") for i in range(2) for j in range(3)] + [(f"P{i}_{j}", f"P{i}_{j+1}") for i in range(3) for j in range(2)]
 finish("oblique_lattice", pts, cors, 2.25, 3.2)
+
+
+# Two grids no corridor of which is like another: each has its own lamp height (2.4 to 3.6 m),
+# spacing (2.0 to 3.2 m), kind (troffers 1.2 x 0.3 or 1.5 x 0.2, square panels 0.6 m, discs
+# 0.4 m), first lamp, and a row on the axis or off it by 0.4 or 0.5 m; places' lamps 2.5 to 3.4
+# m up. The localizer's models take one usual height (the continuity check) and one spacing.
+KINDS = [(1.2, 0.3), (1.2, 0.3), (0.6, 0.6), (1.5, 0.2), (0.4,)]
+
+
+def mixed(name, xs, ys, missing, seed):
+    rng = random.Random(seed)
+    pts = {f"J{i}_{j}": (x, y) for i, x in enumerate(xs) for j, y in enumerate(ys)}
+    cors = [(f"J{i}_{j}", f"J{i + 1}_{j}") for i in range(len(xs) - 1) for j in range(len(ys))] + \
+           [(f"J{i}_{j}", f"J{i}_{j + 1}") for i in range(len(xs)) for j in range(len(ys) - 1)]
+    cors.remove(missing)
+    heights = {n: round(rng.uniform(2.5, 3.4), 2) for n in pts}
+    styles = []
+    for _ in cors:
+        sp = round(rng.uniform(2.0, 3.2), 2)
+        styles.append((round(rng.uniform(2.4, 3.6), 2), sp, rng.choice(KINDS),
+                       rng.choice([0.0, 0.0, 0.0, 0.4, -0.5]), rng.uniform(0.3, 1.0) * sp))
+    finish(name, pts, cors, 0, 0, w=2.2, style=styles.__getitem__, place_height=heights.get)
+
+
+# x1: 4 x 3 junctions 15 x 13 m apart, a corridor missing
+mixed("mixed_grid", [0, 15, 30, 45], [0, 13, 26], ("J1_1", "J2_1"), 111)
+# x2: blocks of uneven size (10, 18 and 12 m across, 9 and 16 m up), a corridor missing
+mixed("mixed_uneven_grid", [0, 10, 28, 40], [0, 9, 25], ("J3_0", "J3_1"), 222)
