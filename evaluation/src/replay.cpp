@@ -157,16 +157,26 @@ void note_wheels(ReplayResult& r, const fusion::OdometryCalibration& c) {
 
 // The floor's swing the ceiling frames showed, when it is past what the models assume: a rough
 // floor or a loose mount, for the user to know (the localizer weighs its lamps for it while it
-// knows where the robot is, either way).
+// knows where the robot is, either way). While it looks for the robot it keeps the models'
+// swing, so that a carry does not hide in the floor's (docs/hypotheses.md, "The lattice's wrong
+// fix"): on such a floor that calls moves that were not, each costing the search what it had
+// learnt, and the user is told how many, the one cost of the floor they can remove.
 void note_swing(ReplayResult& r, const fusion::CeilingContinuity* c,
-                const fusion::CeilingContinuityOptions& o) {
+                const fusion::CeilingContinuityOptions& o, const fusion::LocalizerCounts& n) {
   if (!c || !c->learnt_tilt_sigma() || c->tilt_sigma() <= o.tilt_sigma) return;
-  r.notes.push_back("the floor swings the ceiling camera by " +
-                    one_decimal(*c->learnt_tilt_sigma() * 180 / M_PI) +
-                    " deg from frame to frame (the localizer's models assume " +
-                    one_decimal(o.tilt_sigma * 180 / M_PI) +
-                    "): the lamps were weighed for it while the robot's place was known; " +
-                    std::to_string(c->tilt_samples()) + " lamps seen twice measured it");
+  std::string line = "the floor swings the ceiling camera by " +
+                     one_decimal(*c->learnt_tilt_sigma() * 180 / M_PI) +
+                     " deg from frame to frame (the localizer's models assume " +
+                     one_decimal(o.tilt_sigma * 180 / M_PI) +
+                     "): the lamps were weighed for it while the robot's place was known; " +
+                     std::to_string(c->tilt_samples()) + " lamps seen twice measured it";
+  if (n.unseen_moves_while_looking > 0)
+    line += ". While the robot was looked for, the ceiling camera called " +
+            std::to_string(n.unseen_moves_while_looking) +
+            " moves the wheels did not see, each starting the search again (judged by the "
+            "models' swing, so that a carry does not hide in the floor's; some may be the "
+            "floor's): a steadier floor or camera mount shortens the time lost";
+  r.notes.push_back(line);
 }
 
 }  // namespace
@@ -211,7 +221,8 @@ ReplayResult replay(const io::MissionLog& log, const graph::TopologicalMap& map,
   for (const auto& p : robot_in.problems()) r.notes.push_back("skipped " + p);
   note_input_faults(r, rt.localizer().counts());
   note_wheels(r, rt.localizer().calibration());
-  note_swing(r, rt.localizer().continuity(), options.runtime.localizer.continuity);
+  note_swing(r, rt.localizer().continuity(), options.runtime.localizer.continuity,
+             rt.localizer().counts());
   const auto& ev = rt.localizer().events();
   for (const auto& e : ev)
     if (e.cause != fusion::ModeCause::initialized) r.events.push_back(e);

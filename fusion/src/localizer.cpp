@@ -292,6 +292,7 @@ struct Localizer::Impl {
     ++counts.unseen_moves;
     moved_after = v.moved_by;
     if (unsure()) {
+      ++counts.unseen_moves_while_looking;
       hypotheses->clear(v.why);
       refresh_status();
       set_mode(LocalizerMode::lost, ModeCause::moved_unseen, v.why);

@@ -171,6 +171,7 @@ struct LocalizerCounts {
   std::uint64_t audits = 0;           // omni frames asked where the robot is while tracking
   std::uint64_t audit_losses = 0;     // of those, the losses an audit proved (in second_opinions)
   std::uint64_t unseen_moves = 0;     // ceiling frames that saw a move the wheels did not
+  std::uint64_t unseen_moves_while_looking = 0;  // of those, while the robot was looked for
   std::uint64_t frames_before_move = 0;  // captured before such a move: weighed no hypothesis
 };
 
