@@ -229,6 +229,50 @@ std::vector<AxisMember> strained_members(const MappingProblem& pb, double trigge
   return group;
 }
 
+std::vector<int> strained_heights(const MappingProblem& pb, double trigger,
+                                  const std::vector<int>& tried) {
+  const auto off = [&](std::size_t i) {
+    const auto g = static_cast<std::size_t>(pb.height_group[i]);
+    return g < pb.group_height.size() ? pb.lamps[i][2] - pb.group_height[g] : 0.0;
+  };
+  std::size_t worst = pb.lamps.size();
+  double worst_off = trigger;
+  for (std::size_t i = 0; i < pb.lamps.size(); ++i)
+    if (std::abs(off(i)) > worst_off &&
+        std::find(tried.begin(), tried.end(), static_cast<int>(i)) == tried.end()) {
+      worst_off = std::abs(off(i));
+      worst = i;
+    }
+  if (worst == pb.lamps.size()) return {};
+  // The landmarks are in the order the drive placed them: a corridor's, one after the other.
+  // Those of other kinds between them are passed over; one of its kind lying the other way, or
+  // close to the shared height, ends the group.
+  std::vector<int> group = {static_cast<int>(worst)};
+  const double w = off(worst);
+  for (const int step : {-1, 1}) {
+    for (auto k = static_cast<std::ptrdiff_t>(worst) + step;
+         k >= 0 && k < static_cast<std::ptrdiff_t>(pb.lamps.size()); k += step) {
+      const auto i = static_cast<std::size_t>(k);
+      if (pb.height_group[i] != pb.height_group[worst]) continue;
+      if (off(i) * w <= 0 || std::abs(off(i)) < trigger / 3) break;
+      group.push_back(static_cast<int>(i));
+    }
+  }
+  return group;
+}
+
+void release_height(MappingProblem& pb, const std::vector<int>& lamps) {
+  const int group = 1 + std::max(*std::max_element(pb.kind.begin(), pb.kind.end()),
+                                 *std::max_element(pb.height_group.begin(), pb.height_group.end()));
+  double sum = 0;
+  for (const int i : lamps) {
+    pb.height_group[static_cast<std::size_t>(i)] = group;
+    sum += pb.lamps[static_cast<std::size_t>(i)][2];
+  }
+  pb.group_height.resize(static_cast<std::size_t>(group) + 1, 0.0);
+  pb.group_height[static_cast<std::size_t>(group)] = sum / static_cast<double>(lamps.size());
+}
+
 void leave_axis(MappingProblem& pb, const std::vector<AxisMember>& group) {
   pb.axes.push_back(direction(pb, group.front()));
   const int axis = static_cast<int>(pb.axes.size()) - 1;
@@ -290,15 +334,18 @@ SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
   // one that held it at the mean of the heights as they stood would pull the lamps towards the
   // height new lamps are first placed at, and under a ceiling higher than that guess the map's
   // heights would creep up only as fast as windows passed.
-  const std::size_t kinds =
-      pb.kind.empty()
-          ? 0
-          : static_cast<std::size_t>(*std::max_element(pb.kind.begin(), pb.kind.end())) + 1;
+  // (Groups of lamps released from their kind's height are heights of their own, held to the
+  // first kind's like any kind.)
+  const std::size_t kinds = pb.height_group.empty()
+                                ? 0
+                                : static_cast<std::size_t>(*std::max_element(
+                                      pb.height_group.begin(), pb.height_group.end())) +
+                                      1;
   std::vector<double> kind_height(kinds, 0.0);
   std::vector<int> kind_count(kinds, 0);
   for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
-    kind_height[static_cast<std::size_t>(pb.kind[i])] += pb.lamps[i][2];
-    ++kind_count[static_cast<std::size_t>(pb.kind[i])];
+    kind_height[static_cast<std::size_t>(pb.height_group[i])] += pb.lamps[i][2];
+    ++kind_count[static_cast<std::size_t>(pb.height_group[i])];
   }
   ceres::HuberLoss height_loss(1.0);
   ceres::TukeyLoss tie_loss(o.kind_tie_sigma > 0 ? o.kind_tie_max_m / o.kind_tie_sigma : 1.0);
@@ -308,14 +355,19 @@ SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
     std::vector<bool> in_problem(kinds, false);
     for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
       if (!in_window[i]) continue;
-      const auto k = static_cast<std::size_t>(pb.kind[i]);
+      const auto k = static_cast<std::size_t>(pb.height_group[i]);
       problem.AddResidualBlock(new ceres::AutoDiffCostFunction<HeightFactor, 1, 4, 1>(
                                    new HeightFactor(o.shared_height_sigma)),
                                &height_loss, pb.lamps[i].data(), &kind_height[k]);
       in_problem[k] = true;
     }
-    // Each kind's height tied to the most common kind's (the first).
-    for (std::size_t k = 1; k < kinds && o.kind_tie_sigma > 0; ++k)
+    // Each kind's height tied to the most common kind's (the first); a group released from its
+    // kind's height is not.
+    const std::size_t lamp_kinds =
+        pb.kind.empty()
+            ? 0
+            : static_cast<std::size_t>(*std::max_element(pb.kind.begin(), pb.kind.end())) + 1;
+    for (std::size_t k = 1; k < std::min(kinds, lamp_kinds) && o.kind_tie_sigma > 0; ++k)
       if (in_problem[k] && in_problem[0])
         problem.AddResidualBlock(new ceres::AutoDiffCostFunction<HeightFactor, 1, 1, 1>(
                                      new HeightFactor(o.kind_tie_sigma, 0)),
@@ -398,6 +450,7 @@ SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
   so.logging_type = ceres::SILENT;
   ceres::Solver::Summary summary;
   ceres::Solve(so, &problem, &summary);
+  pb.group_height = kind_height;
 
   SolveReport rep;
   double sum = 0;

@@ -24,7 +24,13 @@ struct MappingProblem {
   std::vector<std::array<double, 4>> lamps;  // landmarks (x, y, z, yaw): estimated
   std::vector<bool> rectangle;               // per landmark
   std::vector<int> axis_of;                  // per landmark: its axis, or -1 (a disc)
-  std::vector<int> kind;                     // per landmark: its kind's shared height
+  std::vector<int> kind;                     // per landmark: its kind
+  // Per landmark: the shared height it hangs at. Its kind's (the group numbered as the kind)
+  // until a solve finds it, with the lamps placed before and after it, hung apart from the
+  // rest of its kind: then a group of its own (release_height). `group_height` is each group's
+  // height as the last solve left it.
+  std::vector<int> height_group;
+  std::vector<double> group_height;
   // Lamps without an axis of their own (round, or square and taken for round) placed one after
   // the other along a straight stretch of the drive: the row's direction is square to `axis`, as
   // a rectangular lamp's own axis is. What holds the heading along a corridor of such lamps.
@@ -90,5 +96,15 @@ std::vector<AxisMember> strained_members(const MappingProblem& problem, double t
 // Puts `group` on an axis of its own, at its first member's direction as solved (a lamp's yaw,
 // a row's from one lamp to the other).
 void leave_axis(MappingProblem& problem, const std::vector<AxisMember>& group);
+
+// The landmark a solve left furthest from its group's shared height, when more than `trigger` m
+// and not among `tried`, with the landmarks of its group placed before and after it that lie off
+// the same way (at least a third of `trigger`): a corridor whose lamps hang higher or lower than
+// the rest of their kind. Empty when none is.
+std::vector<int> strained_heights(const MappingProblem& problem, double trigger,
+                                  const std::vector<int>& tried);
+
+// Gives `lamps` a shared height of their own, starting at their mean.
+void release_height(MappingProblem& problem, const std::vector<int>& lamps);
 
 }  // namespace lampnav::mapping

@@ -60,6 +60,8 @@ void LampMapperOptions::validate() const {
   check(row_max_turn_rad >= 0 && row_max_turn_rad < M_PI / 4, "row_max_turn_rad",
         "must be between 0 and pi/4");
   check(shared_height_sigma >= 0, "shared_height_sigma", "must not be negative");
+  check(height_release_m >= 0, "height_release_m", "must not be negative");
+  check(height_release_chi2 > 0, "height_release_chi2", "must be positive");
   check(kind_tie_sigma >= 0, "kind_tie_sigma", "must not be negative");
   check(kind_tie_max_m > kind_tie_sigma, "kind_tie_max_m", "must be above kind_tie_sigma");
   check(min_sightings >= 1, "min_sightings", "must be at least 1");
@@ -237,6 +239,7 @@ struct LampMapper::Impl {
         pb.axis_of.push_back(rect && o.square_lamps ? axis_for(pb, yaw, o.square_gate_rad) : -1);
         if (!rect && o.square_lamps) add_row(best, kind, at, est, travel);
         pb.kind.push_back(kind);
+        pb.height_group.push_back(kind);
         sizes.emplace_back();
         widths.emplace_back();
         last_seen_travel.push_back(travel);
@@ -318,6 +321,30 @@ struct LampMapper::Impl {
     last = {lamp, robot.yaw(), travel_m};
   }
 
+  // Tries, one after another (at most kMaxReleases), the groups `strained(tried)` names, each
+  // freed by `release`: kept when the solve then fits the drive better by at least `chi2` (more
+  // than the freedom gained explains by chance), else the problem is put back.
+  template <class Member, class Strained, class Release>
+  void try_releases(SolveReport& r, const LampMapperOptions& so, std::size_t first_free,
+                    double chi2, Strained strained, Release release) {
+    std::vector<Member> tried;
+    for (int k = 0; r.converged && k < kMaxReleases; ++k) {
+      const std::vector<Member> group = strained(tried);
+      if (group.empty()) break;
+      tried.insert(tried.end(), group.begin(), group.end());
+      const MappingProblem before = pb;
+      release(group);
+      const SolveReport trial = solve(pb, geometry, so, focal_px, first_free);
+      ++result.solves;
+      result.solve_seconds += trial.seconds;
+      if (r.chi2 - trial.chi2 >= chi2) {
+        r = trial;
+      } else {
+        pb = before;
+      }
+    }
+  }
+
   void run_solve(std::size_t first_free = 0, int iterations = 0) {
     if (pb.poses.size() < 2) return;
     LampMapperOptions so = o;
@@ -327,24 +354,24 @@ struct LampMapper::Impl {
     result.solve_seconds += r.seconds;
     // A corridor a little off the grid, whose first lamp the wheels placed within the gate of
     // the grid's axis: its lamps are pulled square, and the camera's sightings turn the poses
-    // that saw them. Such a group, one after the other, leaves for an axis of its own when the
-    // solve then fits the drive better by more than the new axis can explain by chance.
-    std::vector<AxisMember> tried;
-    for (int k = 0; o.square_lamps && r.converged && k < kMaxReleases; ++k) {
-      const std::vector<AxisMember> group = strained_members(pb, o.square_release_rad, tried);
-      if (group.empty()) break;
-      tried.insert(tried.end(), group.begin(), group.end());
-      const MappingProblem before = pb;
-      leave_axis(pb, group);
-      const SolveReport trial = solve(pb, geometry, so, focal_px, first_free);
-      ++result.solves;
-      result.solve_seconds += trial.seconds;
-      if (r.chi2 - trial.chi2 >= o.square_release_chi2) {
-        r = trial;
-      } else {
-        pb = before;
-      }
-    }
+    // that saw them. Such a group, one after the other, leaves for an axis of its own.
+    if (o.square_lamps)
+      try_releases<AxisMember>(
+          r, so, first_free, o.square_release_chi2,
+          [&](const std::vector<AxisMember>& tried) {
+            return strained_members(pb, o.square_release_rad, tried);
+          },
+          [&](const std::vector<AxisMember>& group) { leave_axis(pb, group); });
+    // A corridor whose lamps hang apart from the rest of their kind (a lower or higher ceiling
+    // there): pulled to the kind's height, they misfit the drive's views; such a group, one after
+    // the other, gets a height of its own.
+    if (o.shared_height_sigma > 0 && o.height_release_m > 0)
+      try_releases<int>(
+          r, so, first_free, o.height_release_chi2,
+          [&](const std::vector<int>& tried) {
+            return strained_heights(pb, o.height_release_m, tried);
+          },
+          [&](const std::vector<int>& group) { release_height(pb, group); });
     result.final_rms_px = r.rms_px;
     learn_new_height();
   }

@@ -78,6 +78,12 @@ struct LampMapperOptions {
   double row_max_turn_rad = 0.1;  // rad the drive turned between placing them
   // Lamps of one kind hang at one height, within this (m; Huber beyond it). 0: each its own.
   double shared_height_sigma = 0.01;
+  // Unless a solve leaves a lamp more than `height_release_m` off its kind's height: it is tried
+  // at a height of its own, with the lamps of its kind placed before and after it that lie off
+  // it the same way, and kept there when the solve's chi-square falls by at least
+  // `height_release_chi2` (a corridor under a lower or higher ceiling). 0: never.
+  double height_release_m = 0.04;
+  double height_release_chi2 = 16;
   // Lamps of several kinds under one ceiling: each kind's height held to the most common kind's
   // within `kind_tie_sigma` while the two are at most `kind_tie_max_m` apart (a Tukey loss:
   // kinds hung further apart, a hall's high lamps and a gallery's low ones, go free). A kind with
