@@ -177,6 +177,11 @@ double direction(const MappingProblem& pb, const AxisMember& m) {
   return std::atan2(t[1] - f[1], t[0] - f[0]);
 }
 
+// How many kinds (or height groups) numbered from 0 `ids` names: its largest plus one.
+std::size_t count_of(const std::vector<int>& ids) {
+  return ids.empty() ? 0 : static_cast<std::size_t>(*std::max_element(ids.begin(), ids.end())) + 1;
+}
+
 }  // namespace
 
 std::vector<AxisMember> strained_members(const MappingProblem& pb, double trigger,
@@ -262,8 +267,7 @@ std::vector<int> strained_heights(const MappingProblem& pb, double trigger,
 }
 
 void release_height(MappingProblem& pb, const std::vector<int>& lamps) {
-  const int group = 1 + std::max(*std::max_element(pb.kind.begin(), pb.kind.end()),
-                                 *std::max_element(pb.height_group.begin(), pb.height_group.end()));
+  const auto group = static_cast<int>(std::max(count_of(pb.kind), count_of(pb.height_group)));
   double sum = 0;
   for (const int i : lamps) {
     pb.height_group[static_cast<std::size_t>(i)] = group;
@@ -334,13 +338,8 @@ SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
   // one that held it at the mean of the heights as they stood would pull the lamps towards the
   // height new lamps are first placed at, and under a ceiling higher than that guess the map's
   // heights would creep up only as fast as windows passed.
-  // (Groups of lamps released from their kind's height are heights of their own, held to the
-  // first kind's like any kind.)
-  const std::size_t kinds = pb.height_group.empty()
-                                ? 0
-                                : static_cast<std::size_t>(*std::max_element(
-                                      pb.height_group.begin(), pb.height_group.end())) +
-                                      1;
+  // (A group of lamps released from its kind's height has a shared height of its own.)
+  const std::size_t kinds = count_of(pb.height_group);
   std::vector<double> kind_height(kinds, 0.0);
   std::vector<int> kind_count(kinds, 0);
   for (std::size_t i = 0; i < pb.lamps.size(); ++i) {
@@ -363,11 +362,7 @@ SolveReport solve(MappingProblem& pb, const fusion::CeilingGeometry& geometry,
     }
     // Each kind's height tied to the most common kind's (the first); a group released from its
     // kind's height is not.
-    const std::size_t lamp_kinds =
-        pb.kind.empty()
-            ? 0
-            : static_cast<std::size_t>(*std::max_element(pb.kind.begin(), pb.kind.end())) + 1;
-    for (std::size_t k = 1; k < std::min(kinds, lamp_kinds) && o.kind_tie_sigma > 0; ++k)
+    for (std::size_t k = 1; k < std::min(kinds, count_of(pb.kind)) && o.kind_tie_sigma > 0; ++k)
       if (in_problem[k] && in_problem[0])
         problem.AddResidualBlock(new ceres::AutoDiffCostFunction<HeightFactor, 1, 1, 1>(
                                      new HeightFactor(o.kind_tie_sigma, 0)),
