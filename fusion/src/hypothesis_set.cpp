@@ -43,6 +43,7 @@ struct HypothesisSet::Impl {
   Stamp completed_at;
   double travel_since_complete = 0;  // m, to the last frame that weighed the set
   int next_id = 1;
+  double swing = 1.0;  // set_floor_swing
   std::string last_why = "no omni image yet";
   Counts counts;
   std::optional<std::pair<Stamp, Pose2>> last_enumeration;  // capture, dead-reckoned pose
@@ -239,9 +240,8 @@ struct HypothesisSet::Impl {
     // One image's least squares knows its noise, not the floor's bumps nor its own aliasing: a
     // newborn is held loosely until the next frames have refined it.
     h.covariance = p.covariance;
-    h.covariance.diagonal() +=
-        Eigen::Vector3d(o.birth_sigma_m * o.birth_sigma_m, o.birth_sigma_m * o.birth_sigma_m,
-                        std::pow(o.birth_sigma_deg * kDeg, 2));
+    const double m = o.birth_sigma_m * swing, deg = o.birth_sigma_deg * swing;
+    h.covariance.diagonal() += Eigen::Vector3d(m * m, m * m, std::pow(deg * kDeg, 2));
     h.odometry = odo.at(stamp);
     h.log_weight = log_weight;
     h.node = p.node;
@@ -508,6 +508,10 @@ HypothesisSet::HypothesisSet(const graph::TopologicalMap& map,
     : impl_(std::make_unique<Impl>(map, ceiling_camera, omni, ceiling_options, options)) {}
 HypothesisSet::~HypothesisSet() = default;
 HypothesisSet::HypothesisSet(HypothesisSet&&) noexcept = default;
+
+void HypothesisSet::set_floor_swing(double factor) {
+  impl_->swing = impl_->o.births_follow_swing ? std::max(1.0, factor) : 1.0;
+}
 
 void HypothesisSet::clear(const std::string& why) {
   Impl& m = *impl_;

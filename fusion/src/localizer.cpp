@@ -389,15 +389,17 @@ struct Localizer::Impl {
     const ContinuityVerdict v = continuity->frame(stamp, lamps, odometry, unsure());
     // The floor's swing as the frames show it: the models that follow a known pose weigh the
     // lamps with it (labelling, the pose measurement, the omni check, scaled alike: the omni
-    // camera rides the same base). The hypotheses keep the configured models: weighed for the
-    // swing they made wrong fixes in a regular building (docs/localization.md).
+    // camera rides the same base). The hypotheses are weighed with the configured models
+    // (weighed for the swing they made wrong fixes in a regular building, docs/localization.md);
+    // only their newborns are held more loosely (HypothesisSetOptions::births_follow_swing).
     const double swing = continuity->tilt_sigma();
     if (swing != floor_swing) {
       floor_swing = swing;
       pipeline->set_floor_swing(swing);
       const double configured = o.continuity.tilt_sigma;
-      if (omni_check)
-        omni_check->scale_tilt(configured > 0 ? std::max(1.0, swing / configured) : 1.0);
+      const double factor = configured > 0 ? std::max(1.0, swing / configured) : 1.0;
+      if (omni_check) omni_check->scale_tilt(factor);
+      if (hypotheses) hypotheses->set_floor_swing(factor);
     }
     // The kidnap monitor's windows were weighed for a steadier floor than there is: once the
     // swing has grown by a quarter over the one they were weighed with, they start again.

@@ -168,8 +168,15 @@ struct HypothesisSetOptions {
   double omni_bump_sigma_m = 0.06;  // floor bumps added to an omni refinement's covariance
   double omni_bump_sigma_deg = 0.15;
   double birth_sigma_m = 0.1, birth_sigma_deg = 1.5;  // a hypothesis born from one image
-  double ceiling_miss_cost = 4.6;                     // -2 ln 0.1, a lamp in clear view not seen
-  double ceiling_spurious_cost = 6.0;                 // a lamp in full view no map lamp explains
+  // On a floor that swings the cameras more than the ceiling pipeline's tilt_sigma (the swing
+  // CeilingContinuity learns), both birth sigmas grow by the swing over tilt_sigma: one image
+  // places the robot that much less well. Held at 1.5 degrees on a floor swinging 1.3, a truth
+  // born 6 degrees off was refined away from itself after a sharp turn, contradicted, and its
+  // half-turn twin published 51 m off (the oblique lattice of docs/hypotheses.md, "Newborns on a
+  // swinging floor"). The weighing keeps the configured models (docs/localization.md).
+  bool births_follow_swing = true;
+  double ceiling_miss_cost = 4.6;      // -2 ln 0.1, a lamp in clear view not seen
+  double ceiling_spurious_cost = 6.0;  // a lamp in full view no map lamp explains
   // The least position uncertainty the ceiling lamps of a hypothesis not yet fitted to ceiling
   // lamps are labelled with (Hypothesis::ceiling_fitted). An omni image places a newborn to 10
   // to 30 cm on a rough floor with the wheels off, and the gate of its own covariance (12 cm)
@@ -361,6 +368,11 @@ class HypothesisSet {
   // `kept_prior`, until the images decide (a false alarm costs nothing but a few frames).
   void keep(Stamp stamp, const Pose2& pose, const Eigen::Matrix3d& covariance,
             const OdometryTrack& odometry);
+
+  // The floor swings the cameras `factor` times the configured tilt (CeilingContinuity's learnt
+  // swing over its tilt_sigma): a newborn's pose is held that much more loosely
+  // (births_follow_swing). Below 1 counts as 1.
+  void set_floor_swing(double factor);
 
   // One omni frame captured at `stamp`: every hypothesis weighed and refined. While the set is
   // incomplete the hypotheses are born again from each image (only the kept estimate carries
