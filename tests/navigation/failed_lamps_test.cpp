@@ -323,12 +323,12 @@ TEST(FailedLampsAndCarries, AHypothesisOffByMoreThanItKnowsIsSearchedAbout) {
 }
 
 // A 3 x 3 lattice of corridors 16 m long crossing at 60 degrees, half-turn symmetric, lamps 3.2 m
-// up (tests/fixtures/maps/oblique_lattice.geojson, the ninth sweep's; scripts/
-// make_look_alike_buildings.py). The floor swings the cameras 1.2 degrees; the continuity check
-// learns 1.3. After the second carry the truth was born 6 degrees off, held at the configured
-// 1.5 degrees; at the lattice's sharp corner its refinement settled 1.2 m away, odd, and its
-// half-turn twin was published 51 m off at 62.5 s. Newborns are now held as loosely as the floor
-// swings (births_follow_swing).
+// up (tests/fixtures/maps/oblique_lattice.geojson: the ninth sweep's map, written by
+// scripts/make_look_alike_buildings.py, its coordinates rounded to the micrometre). The floor
+// swings the cameras 1.2 degrees; the continuity check learns 1.2 to 1.4. After the second carry
+// the truth was born 6 degrees off, held at the configured 1.5 degrees; at the lattice's sharp
+// corner its refinement settled 1.2 m away, odd, and its half-turn twin was published 51 m off
+// at 62.5 s. Newborns are now held as loosely as the floor swings (births_follow_swing).
 TEST(FailedLampsAndCarries, NewbornsOnASwingingFloorAreHeldAsLooselyAsItSwings) {
   const std::string geojson = test::slurp(test::fixture("maps/oblique_lattice.geojson"));
   expect_mended([&](bool with_change) {

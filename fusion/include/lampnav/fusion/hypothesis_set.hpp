@@ -170,8 +170,8 @@ struct HypothesisSetOptions {
   double birth_sigma_m = 0.1, birth_sigma_deg = 1.5;  // a hypothesis born from one image
   // On a floor that swings the cameras more than the ceiling pipeline's tilt_sigma (the swing
   // CeilingContinuity learns), both birth sigmas grow by the swing over tilt_sigma: one image
-  // places the robot that much less well. Held at 1.5 degrees on a floor swinging 1.3, a truth
-  // born 6 degrees off was refined away from itself after a sharp turn, contradicted, and its
+  // places the robot that much less well. Held at 1.5 degrees on a floor swinging 1.2 to 1.4, a
+  // truth born 6 degrees off was refined away from itself after a sharp turn, contradicted, and its
   // half-turn twin published 51 m off (the oblique lattice of docs/hypotheses.md, "Newborns on a
   // swinging floor"). The weighing keeps the configured models (docs/localization.md).
   bool births_follow_swing = true;
