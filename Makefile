@@ -7,7 +7,7 @@ JOBS ?= $(shell nproc)
 LAMPNAV := $(BUILD_DIR)/apps/lampnav
 OUT ?= lampnav-out
 
-.PHONY: all deps configure build demo test test-quick bench format clean interop-deps test-sanitized fuzz
+.PHONY: all deps configure build demo test test-quick bench sweep format clean interop-deps test-sanitized fuzz
 
 all: build
 
@@ -93,6 +93,11 @@ fuzz: deps
 
 bench: build
 	@cmake --build $(BUILD_DIR) --target benchmarks
+
+# The localization sweep (docs/hypotheses.md, "The thirteenth sweep"): 64 carried drives on
+# buildings the localizer was not tuned on, replayed without their start; about 10 minutes.
+sweep: build
+	@python3 scripts/localization_sweep.py --build $(BUILD_DIR) --out $(BUILD_DIR)/sweep
 
 format:
 	@git ls-files '*.cpp' '*.hpp' | xargs clang-format -i
