@@ -4,6 +4,7 @@ three times, replayed without their start; counts the wrong fixes (the first rul
 pose published as certain) and the time unsure. docs/hypotheses.md, "The thirteenth sweep".
 
     scripts/localization_sweep.py [--build DIR] [--out DIR] [--jobs N] [--only TEXT] [--lampnav BIN]
+                                  [--seed-offset N]
 
 Writes OUT/maps (five generated grids, bench/make_building, and the look-alike buildings of
 scripts/make_look_alike_buildings.py), OUT/logs (one `lampnav sim` log a drive: two seeds a
@@ -103,9 +104,14 @@ def main():
     ap.add_argument("--lampnav", help="program that replays (default BUILD/apps/lampnav)")
     ap.add_argument("--jobs", type=int, default=2, help="drives at a time (default 2)")
     ap.add_argument("--only", default="", help="only drives whose name contains this")
+    ap.add_argument("--seed-offset", type=int, default=0,
+                    help="add this to both seeds: the same floors, other drives (a held-out "
+                         "sweep; default 0)")
     a = ap.parse_args()
     if a.jobs < 1:
         fail("--jobs: must be at least 1", 2)
+    if not 0 <= a.seed_offset <= 1000000:
+        fail("--seed-offset: must be 0 to 1000000", 2)
     lampnav = a.lampnav or os.path.join(a.build, "apps", "lampnav")
     recorder = os.path.join(a.build, "apps", "lampnav")
     make_building = os.path.join(a.build, "bench", "make_building")
@@ -125,20 +131,21 @@ def main():
     drives = []
     for building in list(GRIDS) + LOOK_ALIKES:
         for route in ROUTES[building]:
-            for seed in SEEDS:
+            for profile in SEEDS:
+                seed = profile + a.seed_offset
                 name = drive_name(building, route, seed)
                 if a.only in name:
-                    drives.append((name, building, route, seed))
+                    drives.append((name, building, route, seed, profile))
     robot = os.path.join(ROOT, "maps", "robots", "pioneer.json")
 
     def record(d):
-        name, building, route, seed = d
+        name, building, route, seed, profile = d
         log = os.path.join(logs, name + ".mcap")
         if os.path.exists(log):
             return
         map_path = os.path.join(maps, building + ".geojson")
         cmd = [recorder, "sim", "--robot", robot, "--map", map_path, "--route", route,
-               "--seed", str(seed), "-q", "-o", log + ".part"] + SEEDS[seed]
+               "--seed", str(seed), "-q", "-o", log + ".part"] + SEEDS[profile]
         for t in KIDNAPS:
             cmd += ["--kidnap", str(t)]
         for lamp in failed_lamps(map_path, seed):
