@@ -13,6 +13,7 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <string>
@@ -34,11 +35,17 @@ double number(const std::string& field, const std::string& text) {
   return v;
 }
 
-std::int64_t integer(const std::string& field, const std::string& text) {
+// A whole number from 0 to `max`: a count cast to a narrower field must not wrap.
+std::int64_t integer(const std::string& field, const std::string& text, double max = 1e15) {
   const double v = number(field, text);
-  if (v != static_cast<double>(static_cast<std::int64_t>(v)) || v < 0 || v > 1e15)
-    throw InputError({"", "argument", field}, "\"" + text + "\" is not a whole number >= 0");
+  if (v != static_cast<double>(static_cast<std::int64_t>(v)) || v < 0 || v > max)
+    throw InputError({"", "argument", field}, "\"" + text + "\" is not a whole number from 0 to " +
+                                                  std::to_string(std::int64_t(max)));
   return static_cast<std::int64_t>(v);
+}
+
+int small(const std::string& field, const std::string& text) {
+  return static_cast<int>(integer(field, text, std::numeric_limits<int>::max()));
 }
 
 bool flag(const std::string& field, const std::string& text) {
@@ -51,16 +58,15 @@ BuildingOptions parse(int argc, char** argv) {
   BuildingOptions o;
   using Set = std::function<void(const std::string&, const std::string&)>;
   const std::map<std::string, Set> fields = {
-      {"nodes", [&](auto& f, auto& v) { o.nodes = static_cast<int>(integer(f, v)); }},
+      {"nodes", [&](auto& f, auto& v) { o.nodes = small(f, v); }},
       {"block_m", [&](auto& f, auto& v) { o.block_m = number(f, v); }},
       {"lamp_spacing_m", [&](auto& f, auto& v) { o.lamp_spacing_m = number(f, v); }},
       {"ceiling_m", [&](auto& f, auto& v) { o.ceiling_m = number(f, v); }},
       {"rooms", [&](auto& f, auto& v) { o.rooms = flag(f, v); }},
-      {"missing_corridors",
-       [&](auto& f, auto& v) { o.missing_corridors = static_cast<int>(integer(f, v)); }},
+      {"missing_corridors", [&](auto& f, auto& v) { o.missing_corridors = small(f, v); }},
       {"wing_lamp_spacing_m", [&](auto& f, auto& v) { o.wing_lamp_spacing_m = number(f, v); }},
       {"lobby", [&](auto& f, auto& v) { o.lobby = flag(f, v); }},
-      {"rows", [&](auto& f, auto& v) { o.rows = static_cast<int>(integer(f, v)); }},
+      {"rows", [&](auto& f, auto& v) { o.rows = small(f, v); }},
       {"row_spacing_m", [&](auto& f, auto& v) { o.row_spacing_m = number(f, v); }},
       {"seed", [&](auto& f, auto& v) { o.seed = static_cast<std::uint64_t>(integer(f, v)); }},
   };
@@ -69,11 +75,12 @@ BuildingOptions parse(int argc, char** argv) {
     const std::size_t eq = arg.find('=');
     const std::string field = arg.substr(0, eq);
     const auto it = fields.find(field);
-    if (eq == std::string::npos || it == fields.end())
+    if (eq == std::string::npos || it == fields.end()) {
+      std::string names;
+      for (const auto& [name, set] : fields) names += (names.empty() ? "" : ", ") + name;
       throw InputError({"", "argument " + std::to_string(k), field},
-                       "expected FIELD=VALUE with FIELD one of nodes, block_m, lamp_spacing_m, "
-                       "ceiling_m, rooms, missing_corridors, wing_lamp_spacing_m, lobby, rows, "
-                       "row_spacing_m, seed");
+                       "expected FIELD=VALUE with FIELD one of " + names);
+    }
     it->second(field, arg.substr(eq + 1));
   }
   return o;
