@@ -8,6 +8,7 @@
 // Exit status 2, naming the argument, on anything it cannot read.
 
 #include <cerrno>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <fstream>
@@ -38,7 +39,8 @@ double number(const std::string& field, const std::string& text) {
 // A whole number from 0 to `max`: a count cast to a narrower field must not wrap.
 std::int64_t integer(const std::string& field, const std::string& text, double max = 1e15) {
   const double v = number(field, text);
-  if (v != static_cast<double>(static_cast<std::int64_t>(v)) || v < 0 || v > max)
+  // The range first: casting a double past int64's (1e20, nan) to it is undefined.
+  if (!(v >= 0 && v <= max) || v != std::floor(v))
     throw InputError({"", "argument", field}, "\"" + text + "\" is not a whole number from 0 to " +
                                                   std::to_string(std::int64_t(max)));
   return static_cast<std::int64_t>(v);
