@@ -80,8 +80,12 @@ void replay_gives_the_live_estimates(const Driven& d, const Scorer& live) {
   // 3.3 s until 11-28, when the omni images' far blobs no lamp explains were charged anew in
   // every image, and the far view told the twin corridor apart within a second. Such blobs now
   // share one bounded account (far_stray_cost_max): the robot drives on along the corridor to
-  // where the twins' near views differ, and relocalizes 11.3 s after the kidnap.
-  EXPECT_LE(m.relocalization_latency_s.max, 15.0);
+  // where the twins' near views differ, and relocalized 11.3 s after the kidnap until 12-07,
+  // on images that fitted the truth and its twin corridor within 2 of each other, each way in
+  // turn. Such an image is a tie now (omni_tie_cost 2, from 1: the same small differences
+  // published twins on the sweeps): the truth leads by 6.6 from 61 s, short of the 6.9 to
+  // publish, until the image that tells them apart (2.3 against 13.0) 20 s after the kidnap.
+  EXPECT_LE(m.relocalization_latency_s.max, 25.0);
   EXPECT_GT(m.lost_s + m.ambiguous_s, 0.0);
   EXPECT_EQ(m.wrong_fixes, 0);
   EXPECT_GT(m.lamps_labelled, m.lamps_seen / 2);

@@ -275,8 +275,11 @@ struct HypothesisSetOptions {
   // An omni frame's cost within this of the best frame's is a tie. What a map's errors leave in
   // an image after each lamp is counted once (its far blobs, the tilt each image fits): on a map
   // 5 cm off, 0.2 to 1.5 an image against the truth, image after image, which published a twin
-  // 20 m off after 40 m (docs/hypotheses.md).
-  double omni_tie_cost = 1.0;
+  // 20 m off after 40 m. Between twins, differences up to 2 an image, each way in turn, added up
+  // like a random walk past publish_ratio: with 1, 8 and 10 wrong fixes on the thirteenth
+  // sweep's 64 drives and 64 held out, 6 and 7 with 2 (docs/hypotheses.md, "Small differences
+  // between twins are ties").
+  double omni_tie_cost = 2.0;
   // A frame's hypotheses weighed on every core (up to four), or on the calling thread only; the
   // results are the same to the last bit.
   bool weigh_in_parallel = true;
