@@ -84,7 +84,7 @@ void replay_gives_the_live_estimates(const Driven& d, const Scorer& live) {
   // on images that fitted the truth and its twin corridor within 2 of each other, each way in
   // turn. Such an image is a tie now (omni_tie_cost 2, from 1: the same small differences
   // published twins on the sweeps): the truth leads by 6.6 from 61 s, short of the 6.9 to
-  // publish, until the image that tells them apart (2.3 against 13.0) 20 s after the kidnap.
+  // publish, until the image that tells them apart (2.3 against 13.0) 21 s after the kidnap.
   EXPECT_LE(m.relocalization_latency_s.max, 25.0);
   EXPECT_GT(m.lost_s + m.ambiguous_s, 0.0);
   EXPECT_EQ(m.wrong_fixes, 0);
