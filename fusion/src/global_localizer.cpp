@@ -64,6 +64,7 @@ void GlobalLocalizerOptions::validate() const {
   check(q.miss_cost >= 0 && q.spurious_cost >= 0 && q.ambiguity_margin >= 0, "pairs.miss_cost",
         "costs must not be negative");
   check(q.cover_sigmas >= 0 && q.cover_sigmas <= 10, "pairs.cover_sigmas", "must be 0 to 10");
+  check(q.far_blob_cost_max >= 0, "pairs.far_blob_cost_max", "must not be negative");
   check(q.distinct_m > 0 && q.distinct_deg > 0, "pairs.distinct_m", "must be positive");
   check(q.candidates >= 1 && q.refined >= 1 && q.refined <= q.candidates, "pairs.candidates",
         "must be positive, with refined <= candidates");

@@ -162,7 +162,8 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
   // (hidden, merged with a neighbour's bloom near the horizon), each blob costs its distance to
   // the nearest lamp, matched or not. Were only the matches to cost there, a place whose far view
   // matched fewer blobs would cost less: under a 4 m ceiling, with 200 blobs a frame, a twin 40 m
-  // off matched 50 fewer than the truth and cost 2 to 4 less a frame.
+  // off matched 50 fewer than the truth and cost 2 to 4 less a frame. A far blob's cost is
+  // capped (far_blob_cost_max): one that fits its lamp badly may be a light no lamp explains.
   for (const Pair& p : taken) {
     if (blobs[p.b].ray.z() >= cos_expect) {
       e.cost += p.cost;
@@ -172,8 +173,9 @@ GlobalLocalizer::Impl::Evaluation GlobalLocalizer::Impl::evaluate(
   }
   for (std::size_t j = 0; j < blobs.size(); ++j)
     if (explained[j] && blobs[j].ray.z() < cos_expect) {
-      e.cost += nearest[j];
-      if (itemized) e.lamp_costs.emplace_back(nearest_lamp[j], nearest[j]);
+      const double c = std::min(nearest[j], q.far_blob_cost_max);
+      e.cost += c;
+      if (itemized) e.lamp_costs.emplace_back(nearest_lamp[j], c);
     }
   // A lamp in clear view is missing when no blob matched it; one crowded by its neighbours only
   // when no blob lies over it either: within the lamp's size and cover_sigmas of its direction's

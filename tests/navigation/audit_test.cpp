@@ -92,7 +92,9 @@ TEST(Audit, ACarryIntoALookAlikeSpotIsFoundByTheOmniView) {
 // estimate was published 20 m off until 136.5 s. Audits every 2 s whose challengers add up
 // noticed it within half a minute (docs/localization.md, "Audits that add up"): a wrong fix,
 // since a carry is excused for 10 s. Audits that also weigh the places the office's own
-// look-alikes carry the estimate to (its half turn among them) notice it within 3 s.
+// look-alikes carry the estimate to (its half turn among them) notice it within 3 s; within 6 s
+// since far blobs cost at most a stray's (LampPairOptions::far_blob_cost_max): the twin's blobs
+// that fit its lamps badly cost less: noticed at 60.5 s by the audits of 2 images (57.5 s).
 TEST(Audit, ACarryIntoTheOfficesTwinCorridorIsFoundByItsLookAlikes) {
   const std::string geojson = test::slurp(test::source_path("maps/office_floor.geojson"));
   const graph::TopologicalMap office = graph::parse_map(geojson, "office_floor.geojson").map;
@@ -140,7 +142,7 @@ TEST(Audit, ACarryIntoTheOfficesTwinCorridorIsFoundByItsLookAlikes) {
   EXPECT_GT(noticed(searched), 65);
   EXPECT_LT(noticed(searched), 80);
   EXPECT_EQ(evaluation::score(searched, log).wrong_fixes, 1);
-  EXPECT_LT(noticed(now), 60);
+  EXPECT_LT(noticed(now), 61);
   EXPECT_EQ(false_audits(now), 0);
   const evaluation::Metrics m = evaluation::score(now, log);
   ASSERT_EQ(m.kidnaps, 2);

@@ -85,7 +85,14 @@ struct LampPairOptions {
   // clear view on rendered views, with people and floor bumps (0.13 to 0.27 % with 3;
   // docs/hypotheses.md).
   double cover_sigmas = 2.0;
-  double spurious_cost = 6.0;     // a blob no lamp explains
+  double spurious_cost = 6.0;  // a blob no lamp explains
+  // Past expect_max_theta_deg a blob costs its distance (d2) to the nearest lamp within 3
+  // sigma, at most this: a blob that fits its lamp worse is as likely a light no lamp explains
+  // (a window, a reflection), which costs spurious_cost. Uncapped, a hypothesis that happened to
+  // have a lamp near such a light paid more for it than one with none: the truth paid 7.9 and
+  // 7.5 for two lights 2.3 degrees beside its lamps near the horizon, and a quarter-turn twin was
+  // published 14 m off (docs/hypotheses.md, "Capping what an image says"). Infinity: uncapped.
+  double far_blob_cost_max = 6.0;
   double ambiguity_margin = 9.2;  // hypotheses within this of the best (2 ln 100) remain
   double distinct_m = 0.75;       // hypotheses closer than this (and distinct_deg) are one
   double distinct_deg = 10.0;
