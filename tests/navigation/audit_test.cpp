@@ -94,7 +94,7 @@ TEST(Audit, ACarryIntoALookAlikeSpotIsFoundByTheOmniView) {
 // since a carry is excused for 10 s. Audits that also weigh the places the office's own
 // look-alikes carry the estimate to (its half turn among them) notice it within 3 s; within 6 s
 // since far blobs cost at most a stray's (LampPairOptions::far_blob_cost_max): at 60.5 s, by the
-// audits of 2 images (57.5 s uncapped; not traced).
+// audits of 2 images (57.5 s uncapped, by one: e^33 past the e^30 an audit needs).
 TEST(Audit, ACarryIntoTheOfficesTwinCorridorIsFoundByItsLookAlikes) {
   const std::string geojson = test::slurp(test::source_path("maps/office_floor.geojson"));
   const graph::TopologicalMap office = graph::parse_map(geojson, "office_floor.geojson").map;
