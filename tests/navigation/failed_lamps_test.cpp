@@ -96,12 +96,16 @@ void as_the_thirteenth_sweep_drove(sim::Scenario& s) {
   s.bump_sigma_rad = 0.8 * M_PI / 180;
 }
 
-// That sweep's `grid_10m_low`: 5 x 5 junctions 10 m apart, lamps 2 m apart 2.6 m up (0.8 m above
-// the omni camera), two corridors missing.
-sim::BuildingOptions grid_10m_low() {
+// That sweep's `grid_10m_low` (5 x 5 junctions 10 m apart, lamps 2 m apart 2.6 m up, 0.8 m above
+// the omni camera, two corridors missing) driven `J2_0 -> J2_4` as the sweep drove it.
+evaluation::Metrics replayed_on_grid_10m_low(std::uint64_t seed,
+                                             const std::vector<std::string>& failed,
+                                             const std::string& log_name,
+                                             const evaluation::ReplayOptions& options) {
   sim::BuildingOptions b = grid(75, 10, 2.0, 2.6, 131);
   b.missing_corridors = 2;
-  return b;
+  return replayed(b, "J2_0", "J2_4", seed, failed, log_name, as_the_thirteenth_sweep_drove,
+                  options);
 }
 
 // A drive a change mended: `drive(false)` replays it without the change (a wrong fix),
@@ -321,24 +325,21 @@ TEST(FailedLampsAndCarries, AnImageOfManyLampsIsNotOddForMatchingThemAll) {
 }
 
 // The fourteenth sweep's drive `grid_10m_low J2_0 -> J2_4` seed 141 (`scripts/localization_sweep.py
-// --seed-offset 10`): 5 x 5 junctions 10 m apart, lamps 2 m apart 2.6 m up (0.8 m above the omni
-// camera), two corridors missing; the floor swings the cameras 0.8 degrees, one lamp in twelve
-// failed, carried at 20, 45 and 70 s. With an image within 1 of the best a tie, two wrong
-// fixes (this drive was not traced; the office grid's and the office mission's were, where
-// images fitted the truth and its twin within 2 of each other, each way in turn, and such small
-// differences added up). An image within 2 of the best is a tie now
+// --seed-offset 10`; replayed_on_grid_10m_low), one lamp in twelve failed. With an image within 1
+// of the best a tie, two wrong fixes (this drive was not traced; the office grid's and the office
+// mission's were, where images fitted the truth and its twin within 2 of each other, each way in
+// turn, and such small differences added up). An image within 2 of the best is a tie now
 // (HypothesisSetOptions::omni_tie_cost, from 1).
 TEST(FailedLampsAndCarries, ImagesWithinTwoOfTheBestAreTies) {
   expect_mended(
       [&](bool with_change) {
         evaluation::ReplayOptions o;
         o.runtime.localizer.hypotheses.omni_tie_cost = with_change ? 2.0 : 1.0;
-        return replayed(
-            grid_10m_low(), "J2_0", "J2_4", 141,
-            {"H0_3-L4", "V4_0-L3", "J2_4-L1",  "V3_1-L4", "H0_0-L1", "R1_0-L13", "H0_1-L3",
-             "R3_2-L4", "V1_3-L2", "R0_3-L14", "R3_2-L7", "V4_1-L3", "J3_3-L1",  "J0_4-L1",
-             "R3_2-L5", "V0_0-L4", "R0_1-L7",  "R0_3-L7", "V4_0-L2", "V3_2-L4",  "R1_0-L1"},
-            "failed_lamps_ties.mcap", as_the_thirteenth_sweep_drove, o);
+        return replayed_on_grid_10m_low(
+            141, {"H0_3-L4", "V4_0-L3", "J2_4-L1",  "V3_1-L4", "H0_0-L1", "R1_0-L13", "H0_1-L3",
+                  "R3_2-L4", "V1_3-L2", "R0_3-L14", "R3_2-L7", "V4_1-L3", "J3_3-L1",  "J0_4-L1",
+                  "R3_2-L5", "V0_0-L4", "R0_1-L7",  "R0_3-L7", "V4_0-L2", "V3_2-L4",  "R1_0-L1"},
+            "failed_lamps_ties.mcap", o);
       },
       3);
 }
@@ -388,13 +389,12 @@ TEST(FailedLampsAndCarries, NewbornsOnASwingingFloorAreHeldAsLooselyAsItSwings) 
   });
 }
 
-// The thirteenth sweep's drive `grid_10m_low J2_0 -> J2_4` seed 131 (`make sweep`): 5 x 5
-// junctions 10 m apart, lamps 2 m apart 2.6 m up (0.8 m above the omni camera), two corridors
-// missing; the floor swings the cameras 0.8 degrees, one lamp in twelve failed, carried at 20,
-// 45 and 70 s. A far blob used to cost its full distance to the lamp nearest it: the truth paid
-// 7.9 and 7.5 for two lights beside its lamps near the horizon, and a quarter-turn twin was
-// published 14 m off (twice on this drive; once with ties of 2, ImagesWithinTwoOfTheBestAreTies).
-// It now costs at most a stray's (LampPairOptions::far_blob_cost_max).
+// The thirteenth sweep's drive `grid_10m_low J2_0 -> J2_4` seed 131 (`make sweep`;
+// replayed_on_grid_10m_low), one lamp in twelve failed. A far blob used to cost its full distance
+// to the lamp nearest it: the truth paid 7.9 and 7.5 for two lights beside its lamps near the
+// horizon, and a quarter-turn twin was published 14 m off (twice on this drive; once with ties of
+// 2, ImagesWithinTwoOfTheBestAreTies). It now costs at most a stray's
+// (LampPairOptions::far_blob_cost_max).
 TEST(FailedLampsAndCarries, AFarBlobCostsAtMostAStrays) {
   expect_mended(
       [&](bool with_change) {
@@ -402,12 +402,11 @@ TEST(FailedLampsAndCarries, AFarBlobCostsAtMostAStrays) {
         if (!with_change)
           o.runtime.localizer.global.pairs.far_blob_cost_max =
               std::numeric_limits<double>::infinity();
-        return replayed(
-            grid_10m_low(), "J2_0", "J2_4", 131,
-            {"R1_1-L6",  "V0_2-L2", "H2_1-L1", "V1_1-L1", "R1_0-L7", "H0_2-L1",  "V1_0-L3",
-             "H3_0-L4",  "R3_2-L7", "H2_2-L4", "J2_1-L1", "R0_1-L6", "V2_3-L2",  "V4_2-L2",
-             "R0_1-L10", "R0_1-L7", "H1_1-L3", "J1_4-L1", "V3_0-L2", "R0_1-L13", "V2_2-L2"},
-            "failed_lamps_grid_10m_low.mcap", as_the_thirteenth_sweep_drove, o);
+        return replayed_on_grid_10m_low(
+            131, {"R1_1-L6",  "V0_2-L2", "H2_1-L1", "V1_1-L1", "R1_0-L7", "H0_2-L1",  "V1_0-L3",
+                  "H3_0-L4",  "R3_2-L7", "H2_2-L4", "J2_1-L1", "R0_1-L6", "V2_3-L2",  "V4_2-L2",
+                  "R0_1-L10", "R0_1-L7", "H1_1-L3", "J1_4-L1", "V3_0-L2", "R0_1-L13", "V2_2-L2"},
+            "failed_lamps_grid_10m_low.mcap", o);
       },
       3);
 }
