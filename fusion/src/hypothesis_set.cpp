@@ -43,7 +43,8 @@ struct HypothesisSet::Impl {
   Stamp completed_at;
   double travel_since_complete = 0;  // m, to the last frame that weighed the set
   int next_id = 1;
-  double swing = 1.0;  // set_floor_swing
+  double swing = 1.0;       // set_floor_swing, as births follow it
+  double swing_seen = 1.0;  // set_floor_swing
   std::string last_why = "no omni image yet";
   Counts counts;
   std::optional<std::pair<Stamp, Pose2>> last_enumeration;  // capture, dead-reckoned pose
@@ -511,6 +512,7 @@ HypothesisSet::HypothesisSet(HypothesisSet&&) noexcept = default;
 
 void HypothesisSet::set_floor_swing(double factor) {
   impl_->swing = impl_->o.births_follow_swing ? std::max(1.0, factor) : 1.0;
+  impl_->swing_seen = std::max(1.0, factor);
 }
 
 void HypothesisSet::clear(const std::string& why) {
@@ -603,10 +605,11 @@ const Hypothesis* HypothesisSet::winner() const {
       m.travel_to_publish() > 0)
     return nullptr;
   const Hypothesis& best = m.hs.front();
-  if (best.weight < m.o.publish_posterior || best.contradicted || m.row_beside ||
-      m.unexplained_lately(best))
+  const double s = m.o.publish_follows_swing ? m.swing_seen : 1.0;
+  if (std::log1p(-best.weight) > s * std::log1p(-m.o.publish_posterior) || best.contradicted ||
+      m.row_beside || m.unexplained_lately(best))
     return nullptr;
-  if (m.hs.size() > 1 && m.hs[0].log_weight - m.hs[1].log_weight < std::log(m.o.publish_ratio))
+  if (m.hs.size() > 1 && m.hs[0].log_weight - m.hs[1].log_weight < s * std::log(m.o.publish_ratio))
     return nullptr;
   return &best;
 }
@@ -639,6 +642,16 @@ std::string HypothesisSet::why() const {
         s << ", waiting for " << metres
           << " m more of travel: the view shows lamps beyond the map's places, so the robot may "
              "be where the map has nothing";
+      }
+      // Said when the margins raised for the floor's swing are what keeps the leader back.
+      if (const double gap = m.hs.size() > 1 ? m.hs[0].log_weight - m.hs[1].log_weight : 0;
+          m.o.publish_follows_swing && m.swing_seen > 1 && gap >= std::log(m.o.publish_ratio)) {
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      ", the likeliest e^%.1f times the next where the floor's swing (%.1f times "
+                      "the models') asks for e^%.1f",
+                      gap, m.swing_seen, m.swing_seen * std::log(m.o.publish_ratio));
+        s << text;
       }
       if (m.unexplained_lately(m.hs.front()))
         s << ", and from the likeliest the ceiling camera saw lamps where the map has none in "

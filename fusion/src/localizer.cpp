@@ -391,7 +391,8 @@ struct Localizer::Impl {
     // lamps with it (labelling, the pose measurement, the omni check, scaled alike: the omni
     // camera rides the same base). The hypotheses are weighed with the configured models
     // (weighed for the swing they made wrong fixes in a regular building, docs/localization.md);
-    // only their newborns are held more loosely (HypothesisSetOptions::births_follow_swing).
+    // only their newborns are held more loosely (HypothesisSetOptions::births_follow_swing) and
+    // their margins to publish raised to the factor (publish_follows_swing).
     const double swing = continuity->tilt_sigma();
     if (swing != floor_swing) {
       floor_swing = swing;

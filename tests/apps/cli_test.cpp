@@ -255,10 +255,13 @@ TEST(Cli, AnOmniImageThatFitsNoPlaceNeverMakesATwinCertain) {
   ASSERT_EQ(r.result.status, 0) << r.result.err;
   std::cout << r.metrics.dump() << "\n";
   EXPECT_EQ(r.metrics.at("wrong_fixes"), 0);
-  // Not by saying nothing: lost 5.9 s of the 36.6 (5.8 of them "one of these"), then tracked,
-  // 2.5 cm RMS.
-  EXPECT_LT(r.metrics.at("lost_s").get<double>(), 10);
-  EXPECT_LT(r.metrics.at("position_error_m").at("rms").get<double>(), 0.05);
+  // With the margins to publish as configured the robot was lost 9.9 s of the 36.6, then tracked
+  // (2.5 cm RMS). Raised to the floor's swing (HypothesisSetOptions::publish_follows_swing; 1.7
+  // degrees learnt, 3.4 times the models'), it is lost 24.6 s: after the first fix (1 s, 17 cm
+  // off) the ceiling camera's false alarms (18, the gates as configured while the robot is looked
+  // for) start the search again more often than e^23 can be gathered. Unsure, never wrong.
+  EXPECT_LT(r.metrics.at("lost_s").get<double>(), 30);
+  EXPECT_LT(r.metrics.at("position_error_m").at("max").get<double>(), 0.25);
 }
 
 // The fixture: the museum seen from (8.0, -2.5) facing 34.4 degrees (0.6 rad), floor tilted by

@@ -270,11 +270,13 @@ TEST(Localizer, ARoughFloorIsWeighedForWhatItIs) {
   std::cout << "swing learnt: " << r.summary() << "\nas configured: " << as_configured.summary()
             << "\n";
   // Two false alarms, at 1.3 and 6.2 s: the first 50 lamps seen twice (5.3 s of frames, which
-  // arrive a second late) measure the swing; none after. Lost for 6 s of the 77.
+  // arrive a second late) measure the swing; none after. Lost for 6 s of the 77 with the margins
+  // to publish as configured; with them raised to the swing (publish_follows_swing) the set
+  // waits longer after each alarm.
   EXPECT_LE(r.false_alarms, 2);
   EXPECT_EQ(r.bad_fixes, 0);
   EXPECT_LE(r.rms_pos(), 0.02);                   // 1.4 cm
-  EXPECT_GT(r.scored, r.wheel_steps * 85 / 100);  // 90 %
+  EXPECT_GT(r.scored, r.wheel_steps * 80 / 100);  // 84.5 % (90 % with the configured margins)
   EXPECT_GE(as_configured.false_alarms, 10);      // 25, and 16 % of the drive tracked
   EXPECT_LT(as_configured.scored, r.scored / 2);
 }

@@ -56,13 +56,17 @@ TEST(Audit, ACarryIntoALookAlikeSpotIsFoundByTheOmniView) {
     return e.cause == fusion::ModeCause::omni_locates_elsewhere &&
            e.reason.find("audit") != std::string::npos;
   };
-  evaluation::ReplayOptions off;
+  // The margins to publish as configured: raised to this floor's swing (publish_follows_swing),
+  // the first fix comes at 26.5 s, after the first carry, and leaves only the second to audit.
+  evaluation::ReplayOptions on;
+  on.runtime.localizer.hypotheses.publish_follows_swing = false;
+  evaluation::ReplayOptions off = on;
   off.runtime.localizer.audit_period = Duration::zero();
   const evaluation::ReplayResult without = evaluation::replay(c.log, c.map, c.robot, off);
   for (const auto& e : without.events) EXPECT_LT(to_seconds(e.stamp), 60) << e.reason;
   EXPECT_GE(evaluation::score(without, c.log).wrong_fixes, 1);
 
-  const evaluation::ReplayResult r = evaluation::replay(c.log, c.map, c.robot);
+  const evaluation::ReplayResult r = evaluation::replay(c.log, c.map, c.robot, on);
   const evaluation::Metrics m = evaluation::score(r, c.log);
   std::vector<double> audits;
   for (const auto& e : r.events) {
