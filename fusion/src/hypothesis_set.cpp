@@ -645,7 +645,8 @@ std::string HypothesisSet::why() const {
       }
       // Said when the margins raised for the floor's swing are what keeps the leader back.
       if (const double gap = m.hs.size() > 1 ? m.hs[0].log_weight - m.hs[1].log_weight : 0;
-          m.o.publish_follows_swing && m.swing_seen > 1 && gap >= std::log(m.o.publish_ratio)) {
+          m.o.publish_follows_swing && m.swing_seen > 1 && gap >= std::log(m.o.publish_ratio) &&
+          gap < m.swing_seen * std::log(m.o.publish_ratio)) {
         char text[160];
         std::snprintf(text, sizeof text,
                       ", the likeliest e^%.1f times the next where the floor's swing (%.1f times "

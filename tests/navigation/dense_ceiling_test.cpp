@@ -4,6 +4,7 @@
 // 1.7 m under the lamps, the lamps of the robot's own corridor bloom into one streak from
 // overhead to the horizon, which the second threshold does not split.
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 
@@ -53,8 +54,12 @@ TEST(DenseCeiling, LampsMergedIntoAStreakAreNotCountedMissing) {
   // The first carry found at 25.5 s. The second was found before the end as well until the
   // margins to publish were raised to the floor's swing (HypothesisSetOptions::
   // publish_follows_swing, 2.0 to 2.7 times the models' here): at 91.5 s the likeliest led by
-  // e^8.6 where e^14.1 is asked, and the drive ends at 100 s.
+  // e^8.6 where e^14.1 is asked, and the drive ends at 100 s. The set's reason says so.
   EXPECT_GE(m.recoveries, 1);
+  EXPECT_TRUE(std::any_of(r.events.begin(), r.events.end(), [](const fusion::LocalizerEvent& e) {
+    return e.reason.find("where the floor's swing (") != std::string::npos &&
+           e.reason.find(" times the models') asks for e^") != std::string::npos;
+  }));
 }
 
 }  // namespace
