@@ -43,8 +43,9 @@ struct HypothesisSet::Impl {
   Stamp completed_at;
   double travel_since_complete = 0;  // m, to the last frame that weighed the set
   int next_id = 1;
-  double swing = 1.0;       // set_floor_swing, as births follow it
-  double swing_seen = 1.0;  // set_floor_swing
+  double swing = 1.0;  // set_floor_swing, at least 1
+  // The power the margins to publish are raised to (publish_follows_swing).
+  double publish_power() const { return o.publish_follows_swing ? swing : 1.0; }
   std::string last_why = "no omni image yet";
   Counts counts;
   std::optional<std::pair<Stamp, Pose2>> last_enumeration;  // capture, dead-reckoned pose
@@ -241,7 +242,8 @@ struct HypothesisSet::Impl {
     // One image's least squares knows its noise, not the floor's bumps nor its own aliasing: a
     // newborn is held loosely until the next frames have refined it.
     h.covariance = p.covariance;
-    const double m = o.birth_sigma_m * swing, deg = o.birth_sigma_deg * swing;
+    const double grow = o.births_follow_swing ? swing : 1.0;
+    const double m = o.birth_sigma_m * grow, deg = o.birth_sigma_deg * grow;
     h.covariance.diagonal() += Eigen::Vector3d(m * m, m * m, std::pow(deg * kDeg, 2));
     h.odometry = odo.at(stamp);
     h.log_weight = log_weight;
@@ -510,10 +512,7 @@ HypothesisSet::HypothesisSet(const graph::TopologicalMap& map,
 HypothesisSet::~HypothesisSet() = default;
 HypothesisSet::HypothesisSet(HypothesisSet&&) noexcept = default;
 
-void HypothesisSet::set_floor_swing(double factor) {
-  impl_->swing = impl_->o.births_follow_swing ? std::max(1.0, factor) : 1.0;
-  impl_->swing_seen = std::max(1.0, factor);
-}
+void HypothesisSet::set_floor_swing(double factor) { impl_->swing = std::max(1.0, factor); }
 
 void HypothesisSet::clear(const std::string& why) {
   Impl& m = *impl_;
@@ -605,7 +604,7 @@ const Hypothesis* HypothesisSet::winner() const {
       m.travel_to_publish() > 0)
     return nullptr;
   const Hypothesis& best = m.hs.front();
-  const double s = m.o.publish_follows_swing ? m.swing_seen : 1.0;
+  const double s = m.publish_power();
   if (std::log1p(-best.weight) > s * std::log1p(-m.o.publish_posterior) || best.contradicted ||
       m.row_beside || m.unexplained_lately(best))
     return nullptr;
@@ -645,13 +644,13 @@ std::string HypothesisSet::why() const {
       }
       // Said when the margins raised for the floor's swing are what keeps the leader back.
       if (const double gap = m.hs.size() > 1 ? m.hs[0].log_weight - m.hs[1].log_weight : 0;
-          m.o.publish_follows_swing && m.swing_seen > 1 && gap >= std::log(m.o.publish_ratio) &&
-          gap < m.swing_seen * std::log(m.o.publish_ratio)) {
+          gap >= std::log(m.o.publish_ratio) &&
+          gap < m.publish_power() * std::log(m.o.publish_ratio)) {
         char text[160];
         std::snprintf(text, sizeof text,
                       ", the likeliest e^%.1f times the next where the floor's swing (%.1f times "
                       "the models') asks for e^%.1f",
-                      gap, m.swing_seen, m.swing_seen * std::log(m.o.publish_ratio));
+                      gap, m.swing, m.publish_power() * std::log(m.o.publish_ratio));
         s << text;
       }
       if (m.unexplained_lately(m.hs.front()))

@@ -129,6 +129,22 @@ void expect_mended(const std::function<evaluation::Metrics(bool with_change)>& d
   EXPECT_EQ(m.wrong_fixes, 0);
 }
 
+// A drive of `grid_10m_low` (replayed_on_grid_10m_low) that a change mended, carried three times
+// (expect_mended): `change` sets the options with the change or without it.
+void expect_mended_on_grid_10m_low(
+    std::uint64_t seed, const std::vector<std::string>& failed, const std::string& log_name,
+    const std::function<void(evaluation::ReplayOptions&, bool with_change)>& change,
+    const std::string& from = "J2_0", const std::string& to = "J2_4",
+    const std::function<void(sim::Scenario&)>& drove = as_the_thirteenth_sweep_drove) {
+  expect_mended(
+      [&](bool with_change) {
+        evaluation::ReplayOptions o;
+        change(o, with_change);
+        return replayed_on_grid_10m_low(seed, failed, log_name, o, from, to, drove);
+      },
+      3);
+}
+
 // The fourth sweep's office-like grid: 4 x 4 junctions 24 m apart, lamps 2.25 m apart 2.7 m up,
 // rooms, a corridor missing; one lamp in twelve failed, carried at 20, 45 and 70 s.
 evaluation::Metrics replayed_on_the_office_grid(const std::string& from, const std::string& to,
@@ -344,19 +360,15 @@ TEST(FailedLampsAndCarries, AnImageOfManyLampsIsNotOddForMatchingThemAll) {
 // turn, and such small differences added up). An image within 2 of the best is a tie now
 // (HypothesisSetOptions::omni_tie_cost, from 1).
 TEST(FailedLampsAndCarries, ImagesWithinTwoOfTheBestAreTies) {
-  expect_mended(
-      [&](bool with_change) {
-        evaluation::ReplayOptions o;
+  expect_mended_on_grid_10m_low(
+      141, {"H0_3-L4", "V4_0-L3", "J2_4-L1",  "V3_1-L4", "H0_0-L1", "R1_0-L13", "H0_1-L3",
+            "R3_2-L4", "V1_3-L2", "R0_3-L14", "R3_2-L7", "V4_1-L3", "J3_3-L1",  "J0_4-L1",
+            "R3_2-L5", "V0_0-L4", "R0_1-L7",  "R0_3-L7", "V4_0-L2", "V3_2-L4",  "R1_0-L1"},
+      "failed_lamps_ties.mcap", [](evaluation::ReplayOptions& o, bool with_change) {
         o.runtime.localizer.hypotheses.omni_tie_cost = with_change ? 2.0 : 1.0;
         // The margins raised to the floor's swing mend it too: as configured, as then.
         o.runtime.localizer.hypotheses.publish_follows_swing = with_change;
-        return replayed_on_grid_10m_low(
-            141, {"H0_3-L4", "V4_0-L3", "J2_4-L1",  "V3_1-L4", "H0_0-L1", "R1_0-L13", "H0_1-L3",
-                  "R3_2-L4", "V1_3-L2", "R0_3-L14", "R3_2-L7", "V4_1-L3", "J3_3-L1",  "J0_4-L1",
-                  "R3_2-L5", "V0_0-L4", "R0_1-L7",  "R0_3-L7", "V4_0-L2", "V3_2-L4",  "R1_0-L1"},
-            "failed_lamps_ties.mcap", o);
-      },
-      3);
+      });
 }
 
 // A 4 x 4 grid of junctions 18 m apart, lamps 2.0 m apart 2.6 m up, 0.8 m above the omni camera,
@@ -415,19 +427,15 @@ TEST(FailedLampsAndCarries, NewbornsOnASwingingFloorAreHeldAsLooselyAsItSwings) 
 // 2, ImagesWithinTwoOfTheBestAreTies). It now costs at most a stray's
 // (LampPairOptions::far_blob_cost_max).
 TEST(FailedLampsAndCarries, AFarBlobCostsAtMostAStrays) {
-  expect_mended(
-      [&](bool with_change) {
-        evaluation::ReplayOptions o;
+  expect_mended_on_grid_10m_low(
+      131, {"R1_1-L6",  "V0_2-L2", "H2_1-L1", "V1_1-L1", "R1_0-L7", "H0_2-L1",  "V1_0-L3",
+            "H3_0-L4",  "R3_2-L7", "H2_2-L4", "J2_1-L1", "R0_1-L6", "V2_3-L2",  "V4_2-L2",
+            "R0_1-L10", "R0_1-L7", "H1_1-L3", "J1_4-L1", "V3_0-L2", "R0_1-L13", "V2_2-L2"},
+      "failed_lamps_grid_10m_low.mcap", [](evaluation::ReplayOptions& o, bool with_change) {
         if (!with_change)
           o.runtime.localizer.global.pairs.far_blob_cost_max =
               std::numeric_limits<double>::infinity();
-        return replayed_on_grid_10m_low(
-            131, {"R1_1-L6",  "V0_2-L2", "H2_1-L1", "V1_1-L1", "R1_0-L7", "H0_2-L1",  "V1_0-L3",
-                  "H3_0-L4",  "R3_2-L7", "H2_2-L4", "J2_1-L1", "R0_1-L6", "V2_3-L2",  "V4_2-L2",
-                  "R0_1-L10", "R0_1-L7", "H1_1-L3", "J1_4-L1", "V3_0-L2", "R0_1-L13", "V2_2-L2"},
-            "failed_lamps_grid_10m_low.mcap", o);
-      },
-      3);
+      });
 }
 
 // The fifteenth sweep's drive `grid_10m_low J0_2 -> J4_2` seed 152 (`scripts/localization_sweep.py
@@ -437,18 +445,15 @@ TEST(FailedLampsAndCarries, AFarBlobCostsAtMostAStrays) {
 // published at 26.5 s, until audits found it at 33.5 s. The margins are raised to the floor's
 // swing now (HypothesisSetOptions::publish_follows_swing): nothing is published on this drive.
 TEST(FailedLampsAndCarries, OnASwingingFloorTheMarginsToPublishFollowTheSwing) {
-  expect_mended(
-      [&](bool with_change) {
-        evaluation::ReplayOptions o;
+  expect_mended_on_grid_10m_low(
+      152, {"V1_0-L4",  "H3_3-L3", "V0_3-L3",  "R0_1-L10", "H2_1-L1",  "H0_2-L1", "H3_0-L4",
+            "H2_4-L4",  "H0_3-L2", "R3_2-L5",  "V4_2-L3",  "J3_0-L1",  "V3_1-L2", "R0_3-L2",
+            "R0_3-L12", "H1_4-L1", "R1_1-L10", "H0_4-L1",  "R1_1-L15", "R3_2-L1", "V3_1-L3"},
+      "failed_lamps_swinging_margins.mcap",
+      [](evaluation::ReplayOptions& o, bool with_change) {
         o.runtime.localizer.hypotheses.publish_follows_swing = with_change;
-        return replayed_on_grid_10m_low(
-            152, {"V1_0-L4",  "H3_3-L3", "V0_3-L3",  "R0_1-L10", "H2_1-L1",  "H0_2-L1", "H3_0-L4",
-                  "H2_4-L4",  "H0_3-L2", "R3_2-L5",  "V4_2-L3",  "J3_0-L1",  "V3_1-L2", "R0_3-L2",
-                  "R0_3-L12", "H1_4-L1", "R1_1-L10", "H0_4-L1",  "R1_1-L15", "R3_2-L1", "V3_1-L3"},
-            "failed_lamps_swinging_margins.mcap", o, "J0_2", "J4_2",
-            as_the_thirteenth_sweep_drove_on_the_rough_floor);
       },
-      3);
+      "J0_2", "J4_2", as_the_thirteenth_sweep_drove_on_the_rough_floor);
 }
 
 }  // namespace
