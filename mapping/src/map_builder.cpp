@@ -284,7 +284,7 @@ std::vector<std::optional<Pose2>> place_parts(
     std::string told;  // how the omni camera told places alike apart
     if (placed.fitting > 1 && omni_camera && !OmniChoiceOptions{}.tries(placed.fits.size())) {
       told = " (too many for the omni camera's views to be tried)";
-    } else if (placed.fitting > 1 && omni_camera) {
+    } else if (placed.fitting >= 1 && omni_camera) {
       if (!omni) omni = omni_views(log, source, robot);
       // The map so far holds the parts placed before this one: their views count as well.
       std::vector<const OmniView*> before;
@@ -296,21 +296,36 @@ std::vector<std::optional<Pose2>> place_parts(
       const OmniChoice c =
           choose_by_omni({&lamps, &path}, {&part.lamps, &part.keyframes}, placed.fits, before,
                          views_during(starts[p], starts[p + 1]), *omni_camera);
-      char buf[240];
+      char buf[320] = "";
       if (c.chosen) {
         placed.motion = placed.fits[*c.chosen].motion;
         placed.shared = placed.fits[*c.chosen].shared;
+        if (placed.fitting == 1)
+          std::snprintf(buf, sizeof buf,
+                        " at one place only, and the omni camera's %d views miss %d lamps with "
+                        "it there (each part's own lamps alone: %d)",
+                        c.views, c.fewest_missed, c.own_missed);
+        else
+          std::snprintf(buf, sizeof buf,
+                        "; of %d places its lamps fit alike, the omni camera's %d views miss %d "
+                        "lamps at this one, and at any other at least %d more",
+                        placed.fitting, c.views, c.fewest_missed, c.least_extra);
+      } else if (c.views > 0 && !c.explains) {
+        // The one place (or the likeliest of several) leaves lamps in view that the views do
+        // not show: the part may lie where the drive before it never went.
+        placed.motion.reset();
         std::snprintf(buf, sizeof buf,
-                      "; of %d places its lamps fit alike, the omni camera's %d views miss %d "
-                      "lamps at this one, and at any other at least %d more",
-                      placed.fitting, c.views, c.fewest_missed, c.least_extra);
+                      " (but the omni camera's %d views miss %d lamps more %s than each part's "
+                      "own lamps alone: it may lie where the drive before it never went)",
+                      c.views, c.joined_extra,
+                      placed.fitting == 1 ? "with it there" : "at the likeliest");
       } else if (c.views > 0) {
         std::snprintf(buf, sizeof buf,
                       " (nor do the omni camera's %d views tell them apart: they miss %d lamps "
                       "at the best, and only %d more at the next)",
                       c.views, c.fewest_missed, c.least_extra);
       }
-      told = c.views > 0 ? buf : "";
+      told = buf;
     }
     if (o.keep_larger_part && !placed.motion && part.lamps.size() > lamps.size()) {
       // A part that cannot join the map so far and maps more lamps than it becomes the base:
@@ -319,6 +334,8 @@ std::vector<std::optional<Pose2>> place_parts(
       char fit[80], buf[800];
       if (placed.fitting == 0)
         std::snprintf(fit, sizeof fit, "fit nowhere on");
+      else if (placed.fitting == 1)
+        std::snprintf(fit, sizeof fit, "fit one place of");
       else
         std::snprintf(fit, sizeof fit, "fit %d places alike of", placed.fitting);
       std::snprintf(
@@ -374,10 +391,18 @@ std::vector<std::optional<Pose2>> place_parts(
                       at.x(), at.y(), at.yaw() * 180 / M_PI);
         where += buf;
       }
-      std::snprintf(tail, sizeof tail,
-                    " is not in the map: its lamps fit %d places of the map before it alike (a "
-                    "regular building; put down at %s%s)%s; drive there without lifting the robot",
-                    placed.fitting, where.c_str(), placed.fitting > 4 ? ", ..." : "", told.c_str());
+      if (placed.fitting == 1)
+        std::snprintf(tail, sizeof tail,
+                      " is not in the map: its lamps fit one place of the map before it (put "
+                      "down at %s)%s; drive there without lifting the robot",
+                      where.c_str(), told.c_str());
+      else
+        std::snprintf(tail, sizeof tail,
+                      " is not in the map: its lamps fit %d places of the map before it alike (a "
+                      "regular building; put down at %s%s)%s; drive there without lifting the "
+                      "robot",
+                      placed.fitting, where.c_str(), placed.fitting > 4 ? ", ..." : "",
+                      told.c_str());
     }
     notes.push_back(std::string(head) + tail);
   }

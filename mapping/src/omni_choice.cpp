@@ -93,6 +93,21 @@ OmniChoice choose_by_omni(const DrivePart& map, const DrivePart& part,
           localizer.score(c.motion * pose, o.position_sigma_m, o.yaw_sigma, v->detection).missing);
     missed.push_back(std::move(per_view));
   }
+  // What each part's views miss of its own lamps alone: the misses no joining causes.
+  std::vector<int> own;
+  {
+    const std::vector<MappedLamp> none;
+    // The localizers keep their maps by reference: each map outlives its localizer.
+    const graph::TopologicalMap map_lamps = joined(map, {&none, nullptr}, Pose2::identity(), 0.3);
+    const graph::TopologicalMap part_lamps = joined({&none, nullptr}, part, Pose2::identity(), 0.3);
+    const fusion::GlobalLocalizer map_alone(map_lamps, omni_camera, lo);
+    const fusion::GlobalLocalizer part_alone(part_lamps, omni_camera, lo);
+    for (const auto& [v, pose] : before)
+      own.push_back(map_alone.score(pose, o.position_sigma_m, o.yaw_sigma, v->detection).missing);
+    for (const auto& [v, pose] : after)
+      own.push_back(part_alone.score(pose, o.position_sigma_m, o.yaw_sigma, v->detection).missing);
+  }
+  out.own_missed = std::accumulate(own.begin(), own.end(), 0);
   std::vector<int> total;
   for (const auto& m : missed) total.push_back(std::accumulate(m.begin(), m.end(), 0));
   const std::size_t best =
@@ -115,7 +130,15 @@ OmniChoice choose_by_omni(const DrivePart& map, const DrivePart& part,
     out.least_extra = std::min(out.least_extra, extra);
     if (extra < o.min_gap + o.gap_sigmas * std::sqrt(against + 1.0)) clear = false;
   }
-  if (clear) out.chosen = best;
+  // Nor is the best taken unless it explains the views about as well as each part alone: the
+  // lamps it puts in clear view that a view does not show, past those the view misses of its own
+  // part's lamps, within the same allowance. A part put down where the drive before it never
+  // went fits no place, but in a regular building its lamps may still fit one or a few places
+  // of the map alike; the omni views see around it what those places do not hold.
+  for (std::size_t v = 0; v < own.size(); ++v)
+    out.joined_extra += std::max(0, missed[best][v] - own[v]);
+  out.explains = out.joined_extra <= o.min_gap + o.gap_sigmas * std::sqrt(out.own_missed + 1.0);
+  if (clear && out.explains) out.chosen = best;
   return out;
 }
 

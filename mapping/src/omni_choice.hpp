@@ -9,6 +9,9 @@
 // drive did not pass under (rooms, far corridors), fewer where a candidate puts more lamps,
 // right or wrong. A building symmetric in its lamps (the bundled office under a half turn about
 // its middle) leaves its twin places alike to this test as well: then the part is not joined.
+// The one place a part fits, or the best of several, must also explain the views about as well
+// as each part's own lamps alone do: a part put down where the drive before never went may fit
+// a look-alike place of the map, whose lamps the views around it do not show.
 // Private to mapping/.
 
 #include <optional>
@@ -45,9 +48,9 @@ struct OmniChoiceOptions {
   int max_views = 60;       // of each part, spread over it
   int max_candidates = 64;  // more alike than this: not tried
 
-  // Whether the views are asked to choose among this many places alike.
+  // Whether the views are asked to choose among this many places alike (or to check the one).
   bool tries(std::size_t candidates) const {
-    return candidates >= 2 && candidates <= static_cast<std::size_t>(max_candidates);
+    return candidates >= 1 && candidates <= static_cast<std::size_t>(max_candidates);
   }
 };
 
@@ -56,6 +59,9 @@ struct OmniChoice {
   int views = 0;                      // scored, both parts
   int fewest_missed = 0;  // lamps in clear view not seen, all views, at the best candidate
   int least_extra = 0;    // the fewest lamps only another candidate misses
+  int own_missed = 0;     // lamps in clear view not seen, all views, each part's own alone
+  int joined_extra = 0;   // lamps the best misses past those, view by view
+  bool explains = false;  // joined_extra within the allowance (the best is chosen only then)
 };
 
 // `map_views` and `part_views` are the omni views taken during each part (any order); a view
