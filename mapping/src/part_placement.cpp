@@ -27,6 +27,17 @@ class PointGrid {
     if (!p.allFinite()) return;
     const long x0 = cell_of(p.x() - r), x1 = cell_of(p.x() + r);
     const long y0 = cell_of(p.y() - r), y1 = cell_of(p.y() + r);
+    // A reach wider than the points' cells (a lamp a failed solve put kilometres up is surely
+    // seen from as far): every point is tried instead of every cell within it.
+    if (static_cast<double>(x1 - x0 + 1) * static_cast<double>(y1 - y0 + 1) >
+        static_cast<double>(cells_.size())) {
+      for (std::size_t i = 0; i < points_.size(); ++i) {
+        if (!points_[i].allFinite()) continue;
+        const double d = (points_[i] - p).norm();
+        if (d <= r) f(i, d);
+      }
+      return;
+    }
     for (long x = x0; x <= x1; ++x) {
       for (long y = y0; y <= y1; ++y) {
         const auto it = cells_.find(key(x, y));
