@@ -372,9 +372,12 @@ std::vector<std::optional<Pose2>> place_parts(
       for (int k = po.end_keyframes; k + po.end_keyframes < n; ++k)
         path.push_back({part.keyframes[k].stamp, T * part.keyframes[k].pose,
                         part.keyframes[k].dead_reckoned, part.keyframes[k].travel_m});
+      // Where the robot was put down, in the map's frame: whoever carried it can check.
       std::snprintf(tail, sizeof tail,
-                    " is in the map: %d of its lamps fall on lamps mapped before it%s",
-                    placed.shared, told.empty() ? " at one place only" : told.c_str());
+                    " is in the map, put down at (%.1f, %.1f) facing %.0f deg: %d of its lamps "
+                    "fall on lamps mapped before it%s",
+                    out[p]->x(), out[p]->y(), out[p]->yaw() * 180 / M_PI, placed.shared,
+                    told.empty() ? " at one place only" : told.c_str());
     } else if (placed.fitting == 0) {
       std::snprintf(tail, sizeof tail,
                     " is not in the map: its %zu lamps fit nowhere on the %zu mapped before it "
