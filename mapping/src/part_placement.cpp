@@ -18,19 +18,18 @@ class PointGrid {
  public:
   PointGrid(std::vector<Vector2d> points, double cell) : points_(std::move(points)), cell_(cell) {
     for (std::size_t i = 0; i < points_.size(); ++i)
-      if (points_[i].allFinite())  // a lamp or pose a failed solve left at NaN is nowhere
+      if (indexable(points_[i], 0))  // a lamp or pose a failed solve left at NaN is nowhere
         cells_[key(cell_of(points_[i].x()), cell_of(points_[i].y()))].push_back(i);
   }
   // Calls f(index, distance) for each point within r of p.
   template <class F>
   void near(const Vector2d& p, double r, F&& f) const {
     if (!p.allFinite()) return;
-    const long x0 = cell_of(p.x() - r), x1 = cell_of(p.x() + r);
-    const long y0 = cell_of(p.y() - r), y1 = cell_of(p.y() + r);
     // A reach wider than the points' cells (a lamp a failed solve put kilometres up is surely
-    // seen from as far): every point is tried instead of every cell within it.
-    if (static_cast<double>(x1 - x0 + 1) * static_cast<double>(y1 - y0 + 1) >
-        static_cast<double>(cells_.size())) {
+    // seen from as far), or past what a cell's index holds: every point is tried instead of
+    // every cell within it.
+    const double across = 2 * r / cell_ + 2;
+    if (!(across * across <= static_cast<double>(cells_.size())) || !indexable(p, r)) {
       for (std::size_t i = 0; i < points_.size(); ++i) {
         if (!points_[i].allFinite()) continue;
         const double d = (points_[i] - p).norm();
@@ -38,6 +37,8 @@ class PointGrid {
       }
       return;
     }
+    const long x0 = cell_of(p.x() - r), x1 = cell_of(p.x() + r);
+    const long y0 = cell_of(p.y() - r), y1 = cell_of(p.y() + r);
     for (long x = x0; x <= x1; ++x) {
       for (long y = y0; y <= y1; ++y) {
         const auto it = cells_.find(key(x, y));
@@ -58,6 +59,11 @@ class PointGrid {
 
  private:
   long cell_of(double v) const { return static_cast<long>(std::floor(v / cell_)); }
+  // Whether the cells within r of p have indices the key holds (2^31 cells either way: a
+  // million kilometres of half-metre cells).
+  bool indexable(const Vector2d& p, double r) const {
+    return p.allFinite() && (std::max(std::abs(p.x()), std::abs(p.y())) + r) / cell_ < 2147483647.0;
+  }
   static std::uint64_t key(long x, long y) {
     return (static_cast<std::uint64_t>(x) << 32) ^ static_cast<std::uint32_t>(y);
   }

@@ -100,6 +100,11 @@ TEST(PartPlacement, APartThatReDrivesUnevenlySpacedLampsIsPlacedWhereItWas) {
   const Placement r = place_part({&map_lamps, &map_path}, {&absurd, &part_path});
   EXPECT_FALSE(r.motion);
   EXPECT_EQ(r.fitting, 0);
+  // One put 10^300 m away is near nothing and rules nothing out: the part is placed as before.
+  absurd.back().xyz = Eigen::Vector3d(1e300, -1e300, 2.7);
+  const Placement far = place_part({&map_lamps, &map_path}, {&absurd, &part_path});
+  ASSERT_TRUE(far.motion);
+  EXPECT_LT((far.motion->translation() - truth.translation()).norm(), 1e-6);
 
   // Evenly spaced, the same corridor fits the part a lamp or two further along as well (its lamps
   // beyond the map's end unseen by the map), or turned end for end: not placed.
