@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <unordered_map>
 
 #include "lampnav/mapping/rigid_fit.hpp"
@@ -62,7 +63,8 @@ class PointGrid {
   // Whether the cells within r of p have indices the key holds (2^31 cells either way: a
   // million kilometres of half-metre cells).
   bool indexable(const Vector2d& p, double r) const {
-    return p.allFinite() && (std::max(std::abs(p.x()), std::abs(p.y())) + r) / cell_ < 2147483647.0;
+    return p.allFinite() && (std::max(std::abs(p.x()), std::abs(p.y())) + r) / cell_ <
+                                static_cast<double>(std::numeric_limits<std::int32_t>::max());
   }
   static std::uint64_t key(long x, long y) {
     return (static_cast<std::uint64_t>(x) << 32) ^ static_cast<std::uint32_t>(y);
