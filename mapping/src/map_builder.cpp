@@ -293,23 +293,46 @@ std::vector<std::optional<Pose2>> place_parts(
           const auto v = views_during(starts[q], starts[q + 1]);
           before.insert(before.end(), v.begin(), v.end());
         }
+      // The places that fit are weighed against those that fit but for one lamp (failed, or
+      // missed by one drive): the views must prefer the one taken to them as well.
+      std::vector<PlacementFit> weighed = placed.fits;
+      std::size_t near = 0;
+      if (OmniChoiceOptions{}.tries(placed.fits.size() + placed.near_fits.size())) {
+        near = placed.near_fits.size();
+        weighed.insert(weighed.end(), placed.near_fits.begin(), placed.near_fits.end());
+      }
       const OmniChoice c =
-          choose_by_omni({&lamps, &path}, {&part.lamps, &part.keyframes}, placed.fits, before,
+          choose_by_omni({&lamps, &path}, {&part.lamps, &part.keyframes}, weighed, before,
                          views_during(starts[p], starts[p + 1]), *omni_camera);
-      char buf[320] = "";
-      if (c.chosen) {
+      char also[64] = "";
+      if (near > 0) std::snprintf(also, sizeof also, " (and %zu more but for one lamp)", near);
+      char buf[400] = "";
+      if (c.chosen && *c.chosen >= placed.fits.size()) {
+        // The views prefer a place that one lamp contradicts: neither is taken.
+        placed.motion.reset();
+        std::snprintf(buf, sizeof buf,
+                      " (but the omni camera's %d views fit best a place where one lamp "
+                      "contradicts it)",
+                      c.views);
+      } else if (c.chosen) {
         placed.motion = placed.fits[*c.chosen].motion;
         placed.shared = placed.fits[*c.chosen].shared;
-        if (placed.fitting == 1)
+        if (placed.fitting == 1 && near == 0)
           std::snprintf(buf, sizeof buf,
                         " at one place only, and the omni camera's %d views miss %d lamps with "
                         "it there (each part's own lamps alone: %d)",
                         c.views, c.fewest_missed, c.own_missed);
+        else if (placed.fitting == 1)
+          std::snprintf(buf, sizeof buf,
+                        " at one place only%s, and the omni camera's %d views miss %d lamps with "
+                        "it there (each part's own lamps alone: %d), and at any of the others at "
+                        "least %d more",
+                        also, c.views, c.fewest_missed, c.own_missed, c.least_extra);
         else
           std::snprintf(buf, sizeof buf,
-                        "; of %d places its lamps fit alike, the omni camera's %d views miss %d "
+                        "; of %d places its lamps fit alike%s, the omni camera's %d views miss %d "
                         "lamps at this one, and at any other at least %d more",
-                        placed.fitting, c.views, c.fewest_missed, c.least_extra);
+                        placed.fitting, also, c.views, c.fewest_missed, c.least_extra);
       } else if (c.views > 0 && !c.explains) {
         // The one place (or the likeliest of several) leaves lamps in view that the views do
         // not show: the part may lie where the drive before it never went.
@@ -320,10 +343,24 @@ std::vector<std::optional<Pose2>> place_parts(
                       c.views, c.joined_extra,
                       placed.fitting == 1 ? "with it there" : "at the likeliest");
       } else if (c.views > 0) {
-        std::snprintf(buf, sizeof buf,
-                      " (nor do the omni camera's %d views tell them apart: they miss %d lamps "
-                      "at the best, and only %d more at the next)",
-                      c.views, c.fewest_missed, c.least_extra);
+        // Where one place fits and the views cannot tell it from those one lamp away, a lamp
+        // failed or missed decided it, not what was seen: it is not taken.
+        if (placed.fitting == 1) {
+          placed.motion.reset();
+          std::snprintf(buf, sizeof buf,
+                        " (but %zu more places fit it but for one lamp, and the omni camera's %d "
+                        "views do not tell them apart: they miss %d lamps at the best, and only "
+                        "%d more at the next)",
+                        near, c.views, c.fewest_missed, c.least_extra);
+        } else {
+          char more[80] = "";
+          if (near > 0)
+            std::snprintf(more, sizeof more, ", or from %zu more that fit but for one lamp", near);
+          std::snprintf(buf, sizeof buf,
+                        " (nor do the omni camera's %d views tell them apart%s: they miss %d "
+                        "lamps at the best, and only %d more at the next)",
+                        c.views, more, c.fewest_missed, c.least_extra);
+        }
       }
       told = buf;
     }
@@ -355,7 +392,7 @@ std::vector<std::optional<Pose2>> place_parts(
       path = part.keyframes;
       continue;
     }
-    char head[200], tail[640];
+    char head[200], tail[900];
     std::snprintf(head, sizeof head,
                   "the ceiling view jumped %.1f s into the drive as no driving could make it (the "
                   "robot was carried): the drive after it, to %.1f s,",

@@ -220,7 +220,11 @@ Placement place_part(const DrivePart& map, const DrivePart& part, const Placemen
   std::vector<PlacementFit> fitting;
   for (const Pose2& T : placer.candidates()) {
     const Score s = placer.score(T, true, o.match_m);
-    if (s.contradictions == 0 && s.shared >= o.min_shared) fitting.push_back({T, s.shared});
+    if (s.shared < o.min_shared) continue;
+    if (s.contradictions == 0)
+      fitting.push_back({T, s.shared});
+    else if (s.contradictions == 1)
+      out.near_fits.push_back({T, s.shared});
   }
   out.fitting = static_cast<int>(fitting.size());
   std::stable_sort(fitting.begin(), fitting.end(),

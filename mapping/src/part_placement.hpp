@@ -57,6 +57,10 @@ struct Placement {
   int shared = 0;                  // lamps the fitting motion puts onto the map's
   int fitting = 0;                 // motions that fit (distinct): 0 none, 1 placed, more: ambiguous
   std::vector<PlacementFit> fits;  // every fitting motion, those sharing the most lamps first
+  // Motions that would fit but for one lamp (failed, or missed by one drive): in a regular
+  // building with a lamp in twelve failed, the one place a part fits is often one such lamp
+  // away from several more, and a place the drive before never went fits one or none of them.
+  std::vector<PlacementFit> near_fits;
 };
 
 Placement place_part(const DrivePart& map, const DrivePart& part,
