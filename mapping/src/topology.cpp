@@ -170,8 +170,18 @@ graph::TopologicalMap build_topology(const MappingResult& mapped, const Topology
   std::vector<Vector2d> corners;
   for (const std::size_t k : keep) corners.push_back(pts[k]);
   cut_corners_met(corners, o.turn_m, parallel);
+  // The longest stretches first: a line is set by the long stretch of a corridor, and a short
+  // one beside it (the robot settling onto the corridor after a turn, a few degrees off its
+  // axis) joins it, where taken in the drive's order it would set a line of its own that the
+  // long stretch, diverging from it, could not join; the bend between them then is no place,
+  // and the corridor, with no place on its line at one end, would be left out with its lamps.
+  std::vector<std::size_t> by_length;
+  for (std::size_t i = 1; i < corners.size(); ++i) by_length.push_back(i);
+  std::stable_sort(by_length.begin(), by_length.end(), [&](std::size_t i, std::size_t j) {
+    return (corners[i] - corners[i - 1]).norm() > (corners[j] - corners[j - 1]).norm();
+  });
   std::vector<Line> lines;
-  for (std::size_t i = 1; i < corners.size(); ++i) {
+  for (const std::size_t i : by_length) {
     const Vector2d a = corners[i - 1], b = corners[i];
     if ((b - a).norm() < o.min_stretch_m) continue;
     const Vector2d d = canonical(b - a);

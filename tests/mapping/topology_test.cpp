@@ -192,6 +192,55 @@ TEST(Topology, AHeadingSettlingAfterATurnLeavesNoCorridorOut) {
   }
 }
 
+// The same loop where the robot settles onto each corridor 4.5 m after the turn, 0.4 m to the
+// outside (5 degrees off it): a stretch longer than corners are cut for (turn_m), parallel enough
+// to share the corridor's line, but off it by more than a line's width at the corridor's far end.
+// Taken in the drive's order, that stretch set a line of its own, the corridor's long stretch one
+// more, the bend between them was no place, and the corridor, with a place on its line at one end
+// only, was left out with its lamps (on a square ring of the localization sweep, `square_ring E2
+// -> E4` seed 171, a whole 32 m side and 8 lamps). The longest stretches now set the lines.
+TEST(Topology, ALongSettlingStretchAfterATurnLeavesNoCorridorOut) {
+  const graph::TopologicalMap truth =
+      generated(100, 5, [](sim::BuildingOptions& bo) { bo.block_m = 30; });
+  const test::Office office;  // for the robot
+  std::vector<Vector2d> corners;
+  for (const char* name : {"J0_0", "J0_3", "J2_3", "J2_0", "J0_0"}) {
+    const graph::Node* n = truth.find_node(name);
+    ASSERT_NE(n, nullptr) << name;
+    corners.push_back(n->point);
+  }
+  std::vector<Vector2d> waypoints = {corners.front()};
+  for (std::size_t i = 1; i + 1 < corners.size(); ++i) {
+    const Vector2d in = (corners[i] - corners[i - 1]).normalized();
+    const Vector2d out = (corners[i + 1] - corners[i]).normalized();
+    waypoints.push_back(corners[i]);
+    waypoints.push_back(corners[i] + 4.5 * out + 0.4 * in);
+  }
+  waypoints.push_back(corners.back());
+  const sim::LampSensors sensors(truth, office.robot);
+  const Vector2d d0 = waypoints[1] - waypoints[0];
+  const test::DriveRecord drive =
+      test::drive_through(waypoints, std::atan2(d0.y(), d0.x()), sensors, office.robot.semi_axis);
+  const MappingResult mapped = test::map_drive(drive, office.robot);
+  TopologyReport rep;
+  const graph::TopologicalMap built = build_topology(mapped, TopologyOptions{}, {}, &rep);
+  std::size_t corridors = 0;
+  for (const auto& n : built.nodes()) corridors += n.place == graph::Place::corridor;
+  std::cout << built.lamp_count() << " lamps placed, " << rep.lamps_outside << " left out, "
+            << corridors << " corridors\n";
+  EXPECT_EQ(rep.lamps_outside, 0u);
+  EXPECT_EQ(built.lamp_count(), mapped.lamps.size());
+  EXPECT_GE(corridors, 4u);
+  const Pose2 to_true = built_to_true(built, truth, drive.start);
+  for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
+    bool placed = false;
+    for (const auto& n : built.nodes())
+      placed = placed || (n.place != graph::Place::corridor &&
+                          (to_true.transform_from(n.point) - corners[i]).norm() < 1.5);
+    EXPECT_TRUE(placed) << "corner " << i;
+  }
+}
+
 // A generated 100-node building (rooms off some corridors, a wing with another lamp spacing),
 // driven down every corridor row by row and then column by column.
 TEST(Topology, GeneratedBuildingDrivenDownEveryCorridorHasTheTrueTopology) {
