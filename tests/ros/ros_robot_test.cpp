@@ -113,6 +113,8 @@ TEST(RosRobot, TakesInputsRefusesDamagedOnesAndPublishes) {
   listen("/lampnav/mode", "std_msgs/msg/String", Qos::state, mode);
   ASSERT_TRUE(test::wait_for([&] {
     return odom.matched() && camera.matched() && command.matched() &&
+           test::readers_matched(node_side,
+                                 {"/odom", "/ceiling_camera/image_raw", "/lampnav/command"}) &&
            drivers.publishers_matched("/cmd_vel") && drivers.publishers_matched("/tf") &&
            drivers.publishers_matched("/lampnav/pose") &&
            drivers.publishers_matched("/lampnav/mode");
@@ -272,7 +274,10 @@ TEST(RosRobot, KeepsTheNewestImagesWhenItFallsBehind) {
   Writer& odom = drivers.writer("/odom", "nav_msgs/msg/Odometry", Qos::sensor_data);
   Writer& camera =
       drivers.writer(o.topics.ceiling_image, "sensor_msgs/msg/Image", Qos::sensor_data);
-  ASSERT_TRUE(test::wait_for([&] { return camera.matched() && odom.matched(); }));
+  ASSERT_TRUE(test::wait_for([&] {
+    return camera.matched() && odom.matched() &&
+           test::readers_matched(node_side, {"/odom", o.topics.ceiling_image});
+  }));
   const int sent = 30;
   for (int k = 0; k < sent; ++k) {
     ASSERT_TRUE(odom.write(
@@ -312,7 +317,9 @@ TEST(RosRobot, HoldsEveryImageUntilReleased) {
   RosRobot robot(node_side, o);
   Writer& camera =
       drivers.writer(o.topics.ceiling_image, "sensor_msgs/msg/Image", Qos::sensor_data);
-  ASSERT_TRUE(test::wait_for([&] { return camera.matched(); }));
+  ASSERT_TRUE(test::wait_for([&] {
+    return camera.matched() && test::readers_matched(node_side, {o.topics.ceiling_image});
+  }));
   auto send = [&](int first, int count) {
     for (int k = first; k < first + count; ++k) {
       ASSERT_TRUE(camera.write(test::mono8_image_cdr(to_nanoseconds(at(0.1 * k)), "ceiling_camera",
@@ -347,7 +354,9 @@ TEST(RosRobot, DecodesCompressedImagesOnTheCamerasThread) {
   std::vector<std::string>& problems = rig.problems;
   Writer& camera =
       drivers.writer(o.topics.ceiling_image, "sensor_msgs/msg/CompressedImage", Qos::sensor_data);
-  ASSERT_TRUE(test::wait_for([&] { return camera.matched(); }));
+  ASSERT_TRUE(test::wait_for([&] {
+    return camera.matched() && test::readers_matched(rig.node_side, {o.topics.ceiling_image});
+  }));
 
   Image8 lamp(64, 48, 12);
   for (int y = 20; y < 28; ++y)
@@ -388,7 +397,10 @@ TEST(RosRobot, TakesAnOperatorsPoseEstimate) {
   Writer& odom = drivers.writer("/odom", "nav_msgs/msg/Odometry", Qos::sensor_data);
   Writer& estimate =
       drivers.writer("/initialpose", "geometry_msgs/msg/PoseWithCovarianceStamped", Qos::state);
-  ASSERT_TRUE(test::wait_for([&] { return odom.matched() && estimate.matched(); }));
+  ASSERT_TRUE(test::wait_for([&] {
+    return odom.matched() && estimate.matched() &&
+           test::readers_matched(node_side, {"/odom", "/initialpose"});
+  }));
   ASSERT_TRUE(odom.write(io::ros2::odometry_message(at(7), "odom", "base_link", Pose2())));
   ASSERT_TRUE(test::wait_for([&] { return robot.counts().odometry.received == 1; }));
   const Eigen::Matrix3d rviz = Eigen::Vector3d(0.25, 0.25, 0.06853891945200942).asDiagonal();
@@ -450,7 +462,9 @@ TEST(RosRobot, TakesStaticTransformsAndTheCamerasFrame) {
 
   Writer& image =
       drivers.writer(o.topics.ceiling_image, "sensor_msgs/msg/CompressedImage", Qos::sensor_data);
-  ASSERT_TRUE(test::wait_for([&] { return image.matched(); }));
+  ASSERT_TRUE(test::wait_for([&] {
+    return image.matched() && test::readers_matched(node_side, {o.topics.ceiling_image});
+  }));
   ASSERT_TRUE(image.write(io::ros2::compressed_image_message(at(1), "ceiling_optical", "png",
                                                              "not decoded before it is taken")));
   ASSERT_TRUE(test::wait_for([&] { return !robot.camera_frame(CameraRole::ceiling).empty(); }));
