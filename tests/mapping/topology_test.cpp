@@ -127,39 +127,68 @@ TEST(Topology, OfficeDrivenDownEveryCorridorHasTheTrueTopology) {
             << built.lamp_count() << " lamps\n";
 }
 
-// A loop around six blocks of a generated building, where after each turn (and, at two corners,
-// into it) the robot leaves the corner a little askew and settles onto the corridor's line 2 m on
+// A loop around six blocks of a generated building (30 m blocks), driven with the office robot's
+// ideal ceiling detections, the robot leaving each corner askew: `settle_m` on along the next
+// corridor, `off_m` to the outside of it; from the third corner on, with `also_into`, askew into
+// the corner too (0.3 m off the line 2 m before it).
+struct LoopDrive {
+  graph::TopologicalMap truth;
+  std::vector<Vector2d> corners;
+  test::DriveRecord drive;
+  MappingResult mapped;
+};
+LoopDrive loop_around_six_blocks(double settle_m, double off_m, bool also_into) {
+  LoopDrive l{generated(100, 5, [](sim::BuildingOptions& bo) { bo.block_m = 30; }), {}, {}, {}};
+  const test::Office office;  // for the robot
+  for (const char* name : {"J0_0", "J0_3", "J2_3", "J2_0", "J0_0"}) {
+    const graph::Node* n = l.truth.find_node(name);
+    if (!n) {
+      ADD_FAILURE() << name << " is not in the generated building";
+      return l;
+    }
+    l.corners.push_back(n->point);
+  }
+  const std::vector<Vector2d>& corners = l.corners;
+  std::vector<Vector2d> waypoints = {corners.front()};
+  for (std::size_t i = 1; i + 1 < corners.size(); ++i) {
+    const Vector2d in = (corners[i] - corners[i - 1]).normalized();
+    const Vector2d out = (corners[i + 1] - corners[i]).normalized();
+    if (also_into && i > 2) waypoints.push_back(corners[i] - 2.0 * in + 0.3 * out);
+    waypoints.push_back(corners[i]);
+    waypoints.push_back(corners[i] + settle_m * out + off_m * in);
+  }
+  waypoints.push_back(corners.back());
+  const sim::LampSensors sensors(l.truth, office.robot);
+  const Vector2d d0 = waypoints[1] - waypoints[0];
+  l.drive =
+      test::drive_through(waypoints, std::atan2(d0.y(), d0.x()), sensors, office.robot.semi_axis);
+  l.mapped = test::map_drive(l.drive, office.robot);
+  return l;
+}
+
+// Every corner of the loop is a place of the built map (within 1.5 m, in the true frame).
+void expect_every_corner_placed(const graph::TopologicalMap& built, const LoopDrive& l) {
+  const Pose2 to_true = built_to_true(built, l.truth, l.drive.start);
+  for (std::size_t i = 0; i + 1 < l.corners.size(); ++i) {
+    bool placed = false;
+    for (const auto& n : built.nodes())
+      placed = placed || (n.place != graph::Place::corridor &&
+                          (to_true.transform_from(n.point) - l.corners[i]).norm() < 1.5);
+    EXPECT_TRUE(placed) << "corner " << i;
+  }
+}
+
+// The loop, where after each turn (and, at two corners, into it) the robot leaves the corner a
+// little askew and settles onto the corridor's line 2 m on
 // (0.3 m to the outside, 8.5 degrees off it, as the simulator's path follower does): the simplified
 // drive keeps that short stretch, which is not parallel enough to share the corridor's line, so the
 // corridor's run began 2 m past the corner, further than a place reaches. The corridor after each
 // turn was left out with its lamps (36 of 130 on the simulator's loop) before such stretches were
 // met where the lines before and after them meet (TopologyOptions::turn_m).
 TEST(Topology, AHeadingSettlingAfterATurnLeavesNoCorridorOut) {
-  const graph::TopologicalMap truth =
-      generated(100, 5, [](sim::BuildingOptions& bo) { bo.block_m = 30; });
-  const test::Office office;  // for the robot
-  std::vector<Vector2d> corners;
-  for (const char* name : {"J0_0", "J0_3", "J2_3", "J2_0", "J0_0"}) {
-    const graph::Node* n = truth.find_node(name);
-    ASSERT_NE(n, nullptr) << name;
-    corners.push_back(n->point);
-  }
-  std::vector<Vector2d> waypoints = {corners.front()};
-  for (std::size_t i = 1; i + 1 < corners.size(); ++i) {
-    const Vector2d in = (corners[i] - corners[i - 1]).normalized();
-    const Vector2d out = (corners[i + 1] - corners[i]).normalized();
-    // Askew after the turn at the first two corners; at the others also into it (two short
-    // stretches in a row, 0.3 m off the line 2 m before the corner).
-    if (i > 2) waypoints.push_back(corners[i] - 2.0 * in + 0.3 * out);
-    waypoints.push_back(corners[i]);
-    waypoints.push_back(corners[i] + 2.0 * out + 0.3 * in);
-  }
-  waypoints.push_back(corners.back());
-  const sim::LampSensors sensors(truth, office.robot);
-  const Vector2d d0 = waypoints[1] - waypoints[0];
-  const test::DriveRecord drive =
-      test::drive_through(waypoints, std::atan2(d0.y(), d0.x()), sensors, office.robot.semi_axis);
-  const MappingResult mapped = test::map_drive(drive, office.robot);
+  const LoopDrive l = loop_around_six_blocks(2.0, 0.3, true);
+  ASSERT_EQ(l.corners.size(), 5u);
+  const MappingResult& mapped = l.mapped;
   for (const double turn_m : {3.5, 0.0}) {
     TopologyOptions o;
     o.turn_m = turn_m;
@@ -180,15 +209,7 @@ TEST(Topology, AHeadingSettlingAfterATurnLeavesNoCorridorOut) {
     // Ten blocks' sides around the loop; a junction passed straight through with no omni camera
     // is no place, so at least the four sides, each one or more corridors.
     EXPECT_GE(corridors, 4u);
-    // Every corner of the loop is a place.
-    const Pose2 to_true = built_to_true(built, truth, drive.start);
-    for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
-      bool placed = false;
-      for (const auto& n : built.nodes())
-        placed = placed || (n.place != graph::Place::corridor &&
-                            (to_true.transform_from(n.point) - corners[i]).norm() < 1.5);
-      EXPECT_TRUE(placed) << "corner " << i;
-    }
+    expect_every_corner_placed(built, l);
   }
 }
 
@@ -200,45 +221,18 @@ TEST(Topology, AHeadingSettlingAfterATurnLeavesNoCorridorOut) {
 // only, was left out with its lamps (on a square ring of the localization sweep, `square_ring E2
 // -> E4` seed 171, a whole 32 m side and 8 lamps). The longest stretches now set the lines.
 TEST(Topology, ALongSettlingStretchAfterATurnLeavesNoCorridorOut) {
-  const graph::TopologicalMap truth =
-      generated(100, 5, [](sim::BuildingOptions& bo) { bo.block_m = 30; });
-  const test::Office office;  // for the robot
-  std::vector<Vector2d> corners;
-  for (const char* name : {"J0_0", "J0_3", "J2_3", "J2_0", "J0_0"}) {
-    const graph::Node* n = truth.find_node(name);
-    ASSERT_NE(n, nullptr) << name;
-    corners.push_back(n->point);
-  }
-  std::vector<Vector2d> waypoints = {corners.front()};
-  for (std::size_t i = 1; i + 1 < corners.size(); ++i) {
-    const Vector2d in = (corners[i] - corners[i - 1]).normalized();
-    const Vector2d out = (corners[i + 1] - corners[i]).normalized();
-    waypoints.push_back(corners[i]);
-    waypoints.push_back(corners[i] + 4.5 * out + 0.4 * in);
-  }
-  waypoints.push_back(corners.back());
-  const sim::LampSensors sensors(truth, office.robot);
-  const Vector2d d0 = waypoints[1] - waypoints[0];
-  const test::DriveRecord drive =
-      test::drive_through(waypoints, std::atan2(d0.y(), d0.x()), sensors, office.robot.semi_axis);
-  const MappingResult mapped = test::map_drive(drive, office.robot);
+  const LoopDrive l = loop_around_six_blocks(4.5, 0.4, false);
+  ASSERT_EQ(l.corners.size(), 5u);
   TopologyReport rep;
-  const graph::TopologicalMap built = build_topology(mapped, TopologyOptions{}, {}, &rep);
+  const graph::TopologicalMap built = build_topology(l.mapped, TopologyOptions{}, {}, &rep);
   std::size_t corridors = 0;
   for (const auto& n : built.nodes()) corridors += n.place == graph::Place::corridor;
   std::cout << built.lamp_count() << " lamps placed, " << rep.lamps_outside << " left out, "
             << corridors << " corridors\n";
   EXPECT_EQ(rep.lamps_outside, 0u);
-  EXPECT_EQ(built.lamp_count(), mapped.lamps.size());
+  EXPECT_EQ(built.lamp_count(), l.mapped.lamps.size());
   EXPECT_GE(corridors, 4u);
-  const Pose2 to_true = built_to_true(built, truth, drive.start);
-  for (std::size_t i = 0; i + 1 < corners.size(); ++i) {
-    bool placed = false;
-    for (const auto& n : built.nodes())
-      placed = placed || (n.place != graph::Place::corridor &&
-                          (to_true.transform_from(n.point) - corners[i]).norm() < 1.5);
-    EXPECT_TRUE(placed) << "corner " << i;
-  }
+  expect_every_corner_placed(built, l);
 }
 
 // A generated 100-node building (rooms off some corridors, a wing with another lamp spacing),
