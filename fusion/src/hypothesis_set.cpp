@@ -43,9 +43,11 @@ struct HypothesisSet::Impl {
   Stamp completed_at;
   double travel_since_complete = 0;  // m, to the last frame that weighed the set
   int next_id = 1;
-  double swing = 1.0;  // set_floor_swing, at least 1
+  double swing = 1.0;          // set_floor_swing, at least 1
+  double publish_swing = 1.0;  // at least swing
+  bool swing_measured = true;
   // The power the margins to publish are raised to (publish_follows_swing).
-  double publish_power() const { return o.publish_follows_swing ? swing : 1.0; }
+  double publish_power() const { return o.publish_follows_swing ? publish_swing : 1.0; }
   std::string last_why = "no omni image yet";
   Counts counts;
   std::optional<std::pair<Stamp, Pose2>> last_enumeration;  // capture, dead-reckoned pose
@@ -512,7 +514,11 @@ HypothesisSet::HypothesisSet(const graph::TopologicalMap& map,
 HypothesisSet::~HypothesisSet() = default;
 HypothesisSet::HypothesisSet(HypothesisSet&&) noexcept = default;
 
-void HypothesisSet::set_floor_swing(double factor) { impl_->swing = std::max(1.0, factor); }
+void HypothesisSet::set_floor_swing(double factor, double publish_factor, bool measured) {
+  impl_->swing = std::max(1.0, factor);
+  impl_->publish_swing = std::max(impl_->swing, publish_factor);
+  impl_->swing_measured = measured;
+}
 
 void HypothesisSet::clear(const std::string& why) {
   Impl& m = *impl_;
@@ -646,11 +652,13 @@ std::string HypothesisSet::why() const {
       if (const double gap = m.hs.size() > 1 ? m.hs[0].log_weight - m.hs[1].log_weight : 0;
           gap >= std::log(m.o.publish_ratio) &&
           gap < m.publish_power() * std::log(m.o.publish_ratio)) {
-        char text[160];
+        char text[200];
         std::snprintf(text, sizeof text,
-                      ", the likeliest e^%.1f times the next where the floor's swing (%.1f times "
-                      "the models') asks for e^%.1f",
-                      gap, m.swing, m.publish_power() * std::log(m.o.publish_ratio));
+                      ", the likeliest e^%.1f times the next where %s (%s%.1f times the models') "
+                      "asks for e^%.1f",
+                      gap, m.swing_measured ? "the floor's swing" : "a floor not measured yet",
+                      m.swing_measured ? "" : "its swing up to ", m.publish_swing,
+                      m.publish_power() * std::log(m.o.publish_ratio));
         s << text;
       }
       if (m.unexplained_lately(m.hs.front()))

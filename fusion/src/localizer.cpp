@@ -68,6 +68,8 @@ struct Localizer::Impl {
   // The tilt spread the continuity check learnt (or the configured one), given to the models
   // that follow a known pose, and the one the kidnap monitor's evidence was weighed with.
   double floor_swing = 0, weighed_swing = 0;
+  bool floor_measured = true;  // swing_measured() when the hypotheses were last told
+  int frames_checked = 0;      // ceiling frames the continuity check has seen
   // Frames captured before this weigh no hypothesis: the robot was moved after them (a move the
   // ceiling camera saw), and the dead reckoning cannot carry them across it.
   std::optional<Stamp> moved_after;
@@ -124,6 +126,30 @@ struct Localizer::Impl {
       auditor.emplace(m, *global, o);
     }
     hypotheses.emplace(m, ceiling_camera, global ? &*global : nullptr, o.ceiling, o.hypotheses);
+  }
+
+  // The learnt swing over the configured tilt, at least 1.
+  double swing_factor(double swing) const {
+    const double configured = o.continuity.tilt_sigma;
+    return configured > 0 ? std::max(1.0, swing / configured) : 1.0;
+  }
+  // Whether the floor's swing is taken as known: measured over tilt_min_samples lamps; or not
+  // being measured (no ceiling camera, no continuity check, learn_tilt off, no ceiling frame yet,
+  // or tilt_window frames gone by without enough lamps seen twice to measure it): the configured
+  // models are then taken as the floor's, as before.
+  bool swing_measured() const {
+    return !continuity || !o.continuity.learn_tilt || continuity->learnt_tilt_sigma() ||
+           frames_checked == 0 || frames_checked > o.continuity.tilt_window;
+  }
+  // The power the margins to publish take: the swing's factor once measured; before, the
+  // largest swing the continuity check could learn (max_tilt_sigma). The first images of a drive
+  // on a floor swinging 0.8 degrees put a half-turn twin ahead of the truth by more than the
+  // steady floor's margins before 50 lamps had measured the floor (docs/hypotheses.md, "A floor
+  // not measured yet"); a set of one place, or one whose runner-up the images rule out by far,
+  // publishes as before.
+  double publish_factor(double factor) const {
+    if (floor_measured || !o.hypotheses.unmeasured_floor_swings_most) return factor;
+    return std::max(factor, swing_factor(o.continuity.max_tilt_sigma));
   }
 
   static LocalizerOptions fix_semi_axis(LocalizerOptions opt, const RobotDescription& robot) {
@@ -387,6 +413,7 @@ struct Localizer::Impl {
     // While the robot is looked for, a move must not hide in the floor's swing: the gates stay
     // as configured there (a false alarm then costs the hypotheses a few frames, never a pose).
     const ContinuityVerdict v = continuity->frame(stamp, lamps, odometry, unsure());
+    if (frames_checked <= o.continuity.tilt_window) ++frames_checked;
     // The floor's swing as the frames show it: the models that follow a known pose weigh the
     // lamps with it (labelling, the pose measurement, the omni check, scaled alike: the omni
     // camera rides the same base). The hypotheses are weighed with the configured models
@@ -394,13 +421,14 @@ struct Localizer::Impl {
     // only their newborns are held more loosely (HypothesisSetOptions::births_follow_swing) and
     // their margins to publish raised to the factor (publish_follows_swing).
     const double swing = continuity->tilt_sigma();
-    if (swing != floor_swing) {
+    const bool measured = swing_measured();
+    if (swing != floor_swing || measured != floor_measured) {
       floor_swing = swing;
+      floor_measured = measured;
       pipeline->set_floor_swing(swing);
-      const double configured = o.continuity.tilt_sigma;
-      const double factor = configured > 0 ? std::max(1.0, swing / configured) : 1.0;
+      const double factor = swing_factor(swing);
       if (omni_check) omni_check->scale_tilt(factor);
-      if (hypotheses) hypotheses->set_floor_swing(factor);
+      if (hypotheses) hypotheses->set_floor_swing(factor, publish_factor(factor), measured);
     }
     // The kidnap monitor's windows were weighed for a steadier floor than there is: once the
     // swing has grown by a quarter over the one they were weighed with, they start again.

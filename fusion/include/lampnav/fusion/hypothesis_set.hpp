@@ -45,6 +45,11 @@ struct HypothesisSetOptions {
   // margins and 6 with these, for 7 to 11 % more time unsure (docs/hypotheses.md, "Margins that
   // follow the floor's swing").
   bool publish_follows_swing = true;
+  // And until the floor's swing is measured (the localizer's continuity check, its first
+  // tilt_min_samples lamps seen twice), f is the largest swing it could measure (max_tilt_sigma
+  // over tilt_sigma, 8.0 by default): on a held-out sweep a half-turn twin was published 2.5 s
+  // into a drive, before the floor was measured (docs/hypotheses.md, "A floor not measured yet").
+  bool unmeasured_floor_swings_most = true;
   // Omni frames that weighed the set since it became complete before it may publish (the image
   // that completed it counts), unless that image was searched alone (no places carried into it)
   // and the map explains all it shows (no blob beyond the map's places): then one image decides,
@@ -383,9 +388,11 @@ class HypothesisSet {
 
   // The floor swings the cameras `factor` times the configured tilt (CeilingContinuity's learnt
   // swing over its tilt_sigma): a newborn's pose is held that much more loosely
-  // (births_follow_swing), and the margins to publish are raised to that power
-  // (publish_follows_swing). Below 1 counts as 1.
-  void set_floor_swing(double factor);
+  // (births_follow_swing). The margins to publish are raised to the power `publish_factor`
+  // (publish_follows_swing): `factor` once the swing is measured, and before that the largest
+  // swing the measurement could find, `measured` false (the localizer's start, docs/hypotheses.md,
+  // "A floor not measured yet"). Below 1 counts as 1.
+  void set_floor_swing(double factor, double publish_factor, bool measured);
 
   // One omni frame captured at `stamp`: every hypothesis weighed and refined. While the set is
   // incomplete the hypotheses are born again from each image (only the kept estimate carries
