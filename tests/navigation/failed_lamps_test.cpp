@@ -34,6 +34,17 @@ sim::BuildingOptions grid(int nodes, double block_m, double spacing_m, double ce
   return b;
 }
 
+// The sweeps' grid of two rows (`grid_two_rows`): 4 x 4 junctions 15 m apart, two rows of lamps
+// 1.5 m apart across every corridor, lamps 2.5 m apart 3 m up, rooms, a corridor missing; about
+// `nodes` nodes.
+sim::BuildingOptions two_rows_grid(int nodes) {
+  sim::BuildingOptions b = grid(nodes, 15, 2.5, 3.0, 93);
+  b.missing_corridors = 1;
+  b.rows = 2;
+  b.row_spacing_m = 1.5;
+  return b;
+}
+
 // `lampnav sim --map B --route 'FROM -> TO' --seed S --kidnap 25 --kidnap 60 --fail-lamp ...
 // --bumps 1.0` on the building (its GeoJSON), with what `more` changes, replayed without its
 // start.
@@ -326,10 +337,7 @@ TEST(FailedLampsAndCarries, AnImageNoHypothesisExplainsStartsTheSetAgain) {
 // odd_image_misfit (20), was contradicted, and the twin was published 30 m off for 6 s. The bound
 // grows with the lamps matched in clear view now (odd_image_misfit_per_lamp).
 TEST(FailedLampsAndCarries, AnImageOfManyLampsIsNotOddForMatchingThemAll) {
-  sim::BuildingOptions b = grid(55, 15, 2.5, 3.0, 93);
-  b.missing_corridors = 1;
-  b.rows = 2;
-  b.row_spacing_m = 1.5;
+  const sim::BuildingOptions b = two_rows_grid(55);
   expect_mended([&](bool with_change) {
     evaluation::ReplayOptions o;
     // Without it the bound was 20 whatever the lamps; and a tie was an image within 1 of the
@@ -463,10 +471,7 @@ TEST(FailedLampsAndCarries, OnASwingingFloorTheMarginsToPublishFollowTheSwing) {
 // times what the models assume, was not measured yet. Until it is, the margins are those of the
 // largest swing the continuity check could measure (unmeasured_floor_swings_most).
 TEST(FailedLampsAndCarries, UntilTheFloorIsMeasuredTheMarginsAreTheRoughestFloors) {
-  sim::BuildingOptions b = grid(54, 15, 2.5, 3.0, 93);
-  b.missing_corridors = 1;
-  b.rows = 2;
-  b.row_spacing_m = 1.5;
+  const sim::BuildingOptions b = two_rows_grid(54);  // as the sweep script asks for it
   expect_mended(
       [&](bool with_change) {
         evaluation::ReplayOptions o;
