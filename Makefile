@@ -36,8 +36,8 @@ interop-deps: deps
 test: build interop-deps
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS)
 
-# The unit tests alone (ctest label quick, under a minute); `ctest -L mission` and `-L interop`
-# run the others (tests/CMakeLists.txt says which is which).
+# The unit tests alone (ctest label quick, under a minute); `ctest -L mission`, `-L interop` and
+# `-L long` run the others (tests/CMakeLists.txt says which is which).
 test-quick: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) -L '^quick$$'
 
